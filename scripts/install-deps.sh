@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of OpenPhaco from Debian packages.
+# Idempotent and non-interactive: safe to run again; does nothing when all is installed.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev          # linear algebra, eigen-solvers, CG
+  libtbb-dev             # oneTBB: task graph, parallel_for
+  libbullet-dev          # btDbvt broadphase, btSoftBody peer
+  libccd-dev             # GJK/MPR narrowphase
+  libopencv-dev          # charts, image metrics
+  libtet1.5-dev          # TetGen (lens tetrahedralisation)
+  nlohmann-json3-dev     # scenario / report JSON
+  libsqlite3-dev         # session records
+  libgtest-dev libgmock-dev
+  libbenchmark-dev       # Google Benchmark
+  libglfw3-dev libepoxy-dev libimgui-dev   # trainer (later issues)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
