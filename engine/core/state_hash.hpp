@@ -22,7 +22,7 @@ class StateHash {
       mix(w);
     }
     uint64_t tail = 0;
-    std::memcpy(&tail, p + i, n - i);
+    if (n > i) std::memcpy(&tail, p + i, n - i);  // an empty span may have a null data()
     mix(tail ^ (uint64_t{n - i} << 56));
     length_ += n;
   }

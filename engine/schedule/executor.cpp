@@ -1,6 +1,7 @@
 #include "engine/schedule/executor.hpp"
 
 #include <oneapi/tbb/flow_graph.h>
+#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
@@ -49,6 +50,10 @@ struct Executor::Impl {
   // (which waits inside the arena), the arena last.
   const FrameGraph& graph;
   int threads;
+  // oneTBB caps workers at the core count; asking for more threads than cores (a determinism
+  // test on 4 threads on a 2-core machine) must really get them, so the cap is raised while
+  // this executor lives.
+  std::unique_ptr<tbb::global_control> parallelism;
   tbb::task_arena arena;
   std::optional<tbb::flow::graph> flow;
   std::vector<std::unique_ptr<Node>> nodes;
@@ -58,7 +63,14 @@ struct Executor::Impl {
   std::optional<AccessTracker> tracker;
   FrameContext ctx;  // the running frame's context; written before any node is released
 
-  Impl(const FrameGraph& g, int n) : graph(g), threads(n), arena(n) {}
+  Impl(const FrameGraph& g, int n) : graph(g), threads(n), parallelism(raise_parallelism(n)), arena(n) {}
+
+  static std::unique_ptr<tbb::global_control> raise_parallelism(int n) {
+    const auto limit = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    if (static_cast<size_t>(n) <= limit) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                 static_cast<size_t>(n));
+  }
 
   void run_system(size_t i) {
     const SystemDesc& s = graph.system(i);

@@ -16,6 +16,9 @@ struct Particles {
 struct Tag {
   int value = 0;
 };
+struct Code {
+  uint64_t value = 0;
+};
 
 TEST(CommandBuffer, NothingChangesUntilApply) {
   World w;
@@ -42,19 +45,19 @@ TEST(CommandBuffer, ApplyOrderIndependentOfWorkers) {
   auto run = [](int workers) {
     World w;
     const Entity e = w.create(EntityKind::Body, "lens");
-    w.add(e, Tag{0});
+    w.add(e, Code{0});
     CommandQueues q(workers);
     for (uint64_t key = 0; key < 20; ++key) {
       const int worker = static_cast<int>((key * 7) % static_cast<uint64_t>(workers));
       // Non-commutative update: the final value encodes the order.
       q.for_worker(worker).push(19 - key, [e, key](World& world) {
-        world.at<Tag>(e).value = world.at<Tag>(e).value * 3 + static_cast<int>(key % 5);
+        world.at<Code>(e).value = world.at<Code>(e).value * 3 + key % 5;  // wraps modulo 2^64
       });
     }
     q.apply(w);
-    return w.at<Tag>(e).value;
+    return w.at<Code>(e).value;
   };
-  const int one = run(1);
+  const uint64_t one = run(1);
   EXPECT_EQ(one, run(2));
   EXPECT_EQ(one, run(4));
 }

@@ -1,0 +1,181 @@
+#include "apps/phaco/commands.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+
+#include "engine/core/clock.hpp"
+#include "engine/core/error.hpp"
+#include "engine/io/scenario.hpp"
+#include "procedures/eye/eye_mesh.hpp"
+#include "procedures/eye/mesh_cache.hpp"
+#include "procedures/scene/run.hpp"
+
+namespace phaco::cli {
+
+namespace {
+
+// Options of the form --name VALUE, plus flags; everything else is positional.
+struct Args {
+  std::vector<std::string> positional;
+  std::vector<std::pair<std::string, std::string>> options;
+  std::vector<std::string> flags;
+
+  std::optional<std::string> option(const std::string& name) const {
+    for (const auto& [k, v] : options) {
+      if (k == name) return v;
+    }
+    return std::nullopt;
+  }
+  bool flag(const std::string& name) const {
+    return std::find(flags.begin(), flags.end(), name) != flags.end();
+  }
+};
+
+Args parse(const std::string& command, const std::vector<std::string>& raw,
+           const std::vector<std::string>& valued, const std::vector<std::string>& flags) {
+  Args a;
+  for (size_t i = 0; i < raw.size(); ++i) {
+    const std::string& s = raw[i];
+    if (s.rfind("--", 0) != 0) {
+      a.positional.push_back(s);
+    } else if (std::find(valued.begin(), valued.end(), s) != valued.end()) {
+      if (i + 1 >= raw.size()) throw InputError(command + ": option " + s + " needs a value");
+      a.options.push_back({s, raw[++i]});
+    } else if (std::find(flags.begin(), flags.end(), s) != flags.end()) {
+      a.flags.push_back(s);
+    } else {
+      throw InputError(command + ": unknown option '" + s + "' (try 'phaco --help')");
+    }
+  }
+  return a;
+}
+
+int parse_int(const std::string& command, const std::string& option, const std::string& text, int lo, int hi) {
+  int value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc{} || end != text.data() + text.size() || value < lo || value > hi) {
+    throw InputError(command + ": " + option + " expects an integer in " + std::to_string(lo) + ".." +
+                     std::to_string(hi) + ", got '" + text + "'");
+  }
+  return value;
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw InputError("cannot write '" + path.string() + "'");
+  out << text;
+  if (!out.flush()) throw InputError("cannot write '" + path.string() + "'");
+}
+
+SceneOptions scene_options(const Args& a, const std::string& command) {
+  SceneOptions o;
+  if (auto t = a.option("--threads")) o.threads = parse_int(command, "--threads", *t, 1, 256);
+  if (auto c = a.option("--cache-dir")) o.cache_dir = *c;
+  return o;
+}
+
+}  // namespace
+
+int validate(const std::vector<std::string>& raw) {
+  const Args a = parse("validate", raw, {}, {});
+  if (a.positional.empty()) throw InputError("validate: give one or more scenario files");
+  int status = kOk;
+  for (const auto& file : a.positional) {
+    try {
+      const Scenario s = load_scenario(file);
+      std::printf("%s: ok (%s, %zu hand(s), %.3f s, %llu frames)\n", file.c_str(),
+                  std::string(to_string(s.drill)).c_str(), s.hands.size(), s.duration_s,
+                  static_cast<unsigned long long>(s.frame_count()));
+    } catch (const InputError& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      status = kBadInput;
+    }
+  }
+  return status;
+}
+
+int mesh(const std::vector<std::string>& raw) {
+  const Args a = parse("mesh", raw, {"--level", "--out", "--layout", "--params"}, {"--no-tets"});
+  if (!a.positional.empty()) throw InputError("mesh: unexpected argument '" + a.positional[0] + "'");
+  const auto out = a.option("--out");
+  if (!out) throw InputError("mesh: --out DIR is required");
+  const int level = parse_int("mesh", "--level", a.option("--level").value_or("3"), eye::kMinLevel, eye::kMaxLevel);
+  const std::string layout_name = a.option("--layout").value_or("curvilinear");
+  if (layout_name != "curvilinear" && layout_name != "isotropic") {
+    throw InputError("mesh: --layout expects 'curvilinear' or 'isotropic', got '" + layout_name + "'");
+  }
+  const auto layout = layout_name == "isotropic" ? eye::CapsuleLayout::Isotropic : eye::CapsuleLayout::Curvilinear;
+  const eye::EyeParams params = a.option("--params") ? eye::load_eye_params(*a.option("--params"))
+                                                     : eye::default_eye_params();
+  const eye::Resolution res = eye::resolution_for_level(level);
+
+  eye::EyeMeshes m;
+  m.res = res;
+  Stopwatch clock;
+  m.cornea = eye::make_cornea(params, res);
+  m.capsule = eye::make_capsule(params, res, layout);
+  m.iris = eye::make_iris(params, res);
+  m.globe = eye::make_globe(params, res);
+  m.lens_surface = eye::make_lens_surface(params, res);
+  const double surfaces_s = clock.elapsed_s();
+  double tets_s = 0;
+  if (!a.flag("--no-tets")) {
+    clock.restart();
+    m.lens_tets = eye::make_lens_tets(params, res);
+    tets_s = clock.elapsed_s();
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(*out, ec);
+  if (ec) throw InputError("mesh: cannot create '" + *out + "': " + ec.message());
+  eye::write_eye_meshes(m, *out);
+
+  std::printf("level %d (%s capsule) -> %s\n", level, layout_name.c_str(), out->c_str());
+  auto row = [](const char* name, const SurfaceMesh& s) {
+    std::printf("  %-13s %8zu vertices %8zu triangles\n", name, s.vertices.size(), s.triangles.size());
+  };
+  row("cornea", m.cornea);
+  row("capsule", m.capsule);
+  row("iris", m.iris);
+  row("globe", m.globe);
+  row("lens_surface", m.lens_surface);
+  if (m.lens_tets) {
+    std::printf("  %-13s %8zu vertices %8zu tets\n", "lens", m.lens_tets->vertices.size(), m.lens_tets->tets.size());
+  }
+  std::printf("generated surfaces in %.3f s, tets in %.3f s\n", surfaces_s, tets_s);
+  return kOk;
+}
+
+int run(const std::vector<std::string>& raw) {
+  const Args a = parse("run", raw, {"--threads", "--report", "--cache-dir"}, {"--json"});
+  if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
+  const Scenario scenario = load_scenario(a.positional[0]);
+  const RunReport report = run_scenario(scenario, scene_options(a, "run"));
+  const nlohmann::json j = to_json(report);
+  if (auto path = a.option("--report")) write_text(*path, j.dump(2) + "\n");
+  if (a.flag("--json")) {
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::fputs(summary_text(report).c_str(), stdout);
+    if (auto path = a.option("--report")) std::printf("report written to %s\n", path->c_str());
+  }
+  return kOk;
+}
+
+int graph(const std::vector<std::string>& raw) {
+  const Args a = parse("graph", raw, {"--out", "--threads", "--cache-dir"}, {});
+  if (a.positional.size() != 1) throw InputError("graph: give exactly one scenario file");
+  const Scenario scenario = load_scenario(a.positional[0]);
+  const auto scene = build_scene(scenario, scene_options(a, "graph"));
+  const std::string dot = scene->graph->to_dot();
+  if (auto path = a.option("--out")) {
+    write_text(*path, dot);
+  } else {
+    std::fputs(dot.c_str(), stdout);
+  }
+  return kOk;
+}
+
+}  // namespace phaco::cli

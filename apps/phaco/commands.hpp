@@ -1,0 +1,18 @@
+#pragma once
+// The headless `phaco` command: one function per subcommand. Each returns the process exit code:
+// 0 success, 2 bad input (message on stderr), 1 internal error.
+#include <string>
+#include <vector>
+
+namespace phaco::cli {
+
+inline constexpr int kOk = 0;
+inline constexpr int kInternalError = 1;
+inline constexpr int kBadInput = 2;
+
+int validate(const std::vector<std::string>& args);
+int mesh(const std::vector<std::string>& args);
+int run(const std::vector<std::string>& args);
+int graph(const std::vector<std::string>& args);
+
+}  // namespace phaco::cli

@@ -1,0 +1,70 @@
+// phaco — the headless OpenPhaco command: validate scenarios, generate eye meshes, run scenarios.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "apps/phaco/commands.hpp"
+#include "engine/core/error.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(phaco — OpenPhaco headless simulator
+
+usage:
+  phaco run FILE [--threads N] [--report OUT.json] [--json] [--cache-dir DIR]
+      Run a scenario headless for its duration at its fixed step; print a summary
+      (or, with --json, the JSON report) and write the JSON report to OUT.json.
+  phaco validate FILE...
+      Check scenario files; every problem is named by file, JSON path and what was expected.
+  phaco mesh --level L --out DIR [--layout curvilinear|isotropic] [--no-tets] [--params FILE]
+      Generate the standard eye's meshes at resolution level L (0..7, default eye level 3:
+      about 8k capsule vertices, 50k lens tets) as OBJ and TetGen .node/.ele files.
+  phaco graph FILE [--out OUT.dot]
+      Print the scenario's per-frame task graph as GraphViz DOT.
+  phaco --help | --version
+
+exit codes: 0 success, 2 bad input (message on stderr), 1 internal error.
+environment: PHACO_DATA_DIR (default: the source tree's data/), PHACO_CACHE_DIR (mesh cache,
+  default ~/.cache/openphaco/meshes).
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    std::fputs(kUsage, stderr);
+    return phaco::cli::kBadInput;
+  }
+  const std::string command = args.front();
+  args.erase(args.begin());
+  try {
+    if (command == "--help" || command == "-h" || command == "help") {
+      std::fputs(kUsage, stdout);
+      return phaco::cli::kOk;
+    }
+    if (command == "--version") {
+      std::puts("phaco 0.1.0");
+      return phaco::cli::kOk;
+    }
+    for (const auto& a : args) {
+      if (a == "--help" || a == "-h") {
+        std::fputs(kUsage, stdout);
+        return phaco::cli::kOk;
+      }
+    }
+    if (command == "run") return phaco::cli::run(args);
+    if (command == "validate") return phaco::cli::validate(args);
+    if (command == "mesh") return phaco::cli::mesh(args);
+    if (command == "graph") return phaco::cli::graph(args);
+    std::fprintf(stderr, "phaco: unknown command '%s' (try 'phaco --help')\n", command.c_str());
+    return phaco::cli::kBadInput;
+  } catch (const phaco::InputError& e) {
+    std::fprintf(stderr, "phaco: %s\n", e.what());
+    return phaco::cli::kBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "phaco: internal error: %s\n", e.what());
+    return phaco::cli::kInternalError;
+  }
+}

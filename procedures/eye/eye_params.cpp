@@ -1,0 +1,139 @@
+#include "procedures/eye/eye_params.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "engine/core/error.hpp"
+
+#ifndef PHACO_DATA_DIR
+#error "PHACO_DATA_DIR must be defined by the build (procedures/CMakeLists.txt)"
+#endif
+
+namespace phaco::eye {
+namespace {
+
+std::string known_keys(const EyeParams& params) {
+  std::string out;
+  for (const auto& [key, value] : params.values) {
+    if (!out.empty()) out += ", ";
+    out += key;
+  }
+  return out;
+}
+
+}  // namespace
+
+double EyeParams::get(const std::string& key) const {
+  const auto it = values.find(key);
+  if (it == values.end()) throw std::out_of_range("eye parameter '" + key + "' is not defined");
+  return it->second;
+}
+
+const std::vector<std::string_view>& required_eye_keys() {
+  static const std::vector<std::string_view> keys = {"lens.equatorial_diameter_mm",
+                                                     "lens.anterior_half_thickness_mm",
+                                                     "lens.posterior_half_thickness_mm",
+                                                     "lens.nucleus_fraction",
+                                                     "lens.density_kg_m3",
+                                                     "capsule.thickness_mm",
+                                                     "capsule.youngs_modulus_kpa",
+                                                     "capsule.ultimate_stress_kpa",
+                                                     "capsule.elongation_at_break",
+                                                     "capsule.poisson_ratio",
+                                                     "capsule.density_kg_m3",
+                                                     "capsule.radius_mm",
+                                                     "capsule.perforation_force_mn",
+                                                     "capsule.rim_strength_mn",
+                                                     "iris.z_mm",
+                                                     "iris.pupil_diameter_mm",
+                                                     "cornea.posterior_apex_z_mm",
+                                                     "cornea.central_thickness_mm",
+                                                     "cornea.anterior_radius_mm",
+                                                     "cornea.posterior_radius_mm",
+                                                     "cornea.limbus_diameter_mm",
+                                                     "globe.axial_length_mm",
+                                                     "globe.radius_mm",
+                                                     "tools.phaco_tip_diameter_mm",
+                                                     "tools.keratome_width_mm",
+                                                     "tools.cystotome_tip_mm",
+                                                     "targets.rhexis_diameter_min_mm",
+                                                     "targets.rhexis_diameter_max_mm",
+                                                     "targets.rhexis_decentration_max_mm",
+                                                     "targets.incision_width_min_mm",
+                                                     "targets.incision_width_max_mm",
+                                                     "targets.trench_width_min_mm",
+                                                     "targets.trench_width_max_mm",
+                                                     "targets.trench_depth_fraction",
+                                                     "targets.trench_crossing_angle_deg"};
+  return keys;
+}
+
+EyeParams load_eye_params(const std::filesystem::path& file) {
+  const std::string where = file.string();
+  std::ifstream in(file);
+  if (!in) throw InputError(where + ": cannot open eye parameter file");
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(where + ": invalid JSON: " + e.what());
+  }
+  if (!doc.is_object()) throw InputError(where + ": top level must be an object of sections");
+
+  EyeParams params;
+  for (const auto& [section, body] : doc.items()) {
+    if (!body.is_object()) {
+      throw InputError(where + ": /" + section + " must be an object of \"key\": number pairs");
+    }
+    for (const auto& [key, value] : body.items()) {
+      const std::string path = "/" + section + "/" + key;
+      // Non-finite numbers cannot appear in strict JSON, so a number here is finite; zero and
+      // negative values are rejected because every eye quantity is a size, modulus or count.
+      if (!value.is_number()) throw InputError(where + ": " + path + " must be a number");
+      const double v = value.get<double>();
+      if (!std::isfinite(v) || v <= 0.0) {
+        throw InputError(where + ": " + path + " must be a finite positive number, got " +
+                         value.dump());
+      }
+      params.values[section + "." + key] = v;
+    }
+  }
+  for (const auto key : required_eye_keys()) {
+    if (!params.values.count(std::string(key))) {
+      const auto dot = key.find('.');
+      throw InputError(where + ": missing /" + std::string(key.substr(0, dot)) + "/" +
+                       std::string(key.substr(dot + 1)));
+    }
+  }
+  return params;
+}
+
+EyeParams default_eye_params() {
+  return load_eye_params(data_dir() / "eye" / "standard_eye.json");
+}
+
+void apply_override(EyeParams& params, const std::string& key, double value) {
+  const auto it = params.values.find(key);
+  if (it == params.values.end()) {
+    throw InputError("unknown eye parameter '" + key + "' (known: " + known_keys(params) + ")");
+  }
+  if (!std::isfinite(value)) {
+    throw InputError("eye parameter '" + key + "' must be finite, got " + std::to_string(value));
+  }
+  if (value <= 0.0) {
+    throw InputError("eye parameter '" + key + "' must be positive, got " + std::to_string(value));
+  }
+  it->second = value;
+}
+
+std::filesystem::path data_dir() {
+  if (const char* env = std::getenv("PHACO_DATA_DIR"); env != nullptr && *env != '\0') {
+    return std::filesystem::path(env);
+  }
+  return std::filesystem::path(PHACO_DATA_DIR);
+}
+
+}  // namespace phaco::eye

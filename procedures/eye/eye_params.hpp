@@ -1,0 +1,38 @@
+#pragma once
+// The standard eye (DESIGN.md §6) as a flat table of named numbers, loaded from
+// data/eye/standard_eye.json. Units are in the key names ("capsule.youngs_modulus_kpa").
+#include <filesystem>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace phaco::eye {
+
+struct EyeParams {
+  std::map<std::string, double>
+      values;  // "section.key" -> value, e.g. "capsule.youngs_modulus_kpa"
+
+  // Throws std::out_of_range naming the key.
+  double get(const std::string& key) const;
+};
+
+// Every key a standard eye file must define; load_eye_params rejects a file missing one of them.
+const std::vector<std::string_view>& required_eye_keys();
+
+// Throws InputError naming the file and the JSON path (e.g. "/lens/nucleus_fraction") on a
+// missing file, invalid JSON, a missing key, or a value that is not a finite positive number.
+EyeParams load_eye_params(const std::filesystem::path& file);
+
+// data_dir() / "eye" / "standard_eye.json".
+EyeParams default_eye_params();
+
+// Throws InputError "unknown eye parameter 'key' (known: ...)", or on a non-finite or non-positive
+// value. Geometric consistency (e.g. capsule radius inside the lens) is checked when meshes are
+// made.
+void apply_override(EyeParams& params, const std::string& key, double value);
+
+// The data directory: env PHACO_DATA_DIR if set, else the source tree's data/ (compile time).
+std::filesystem::path data_dir();
+
+}  // namespace phaco::eye

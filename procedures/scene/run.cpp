@@ -1,0 +1,101 @@
+#include "procedures/scene/run.hpp"
+
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <numeric>
+
+#include "engine/core/clock.hpp"
+
+namespace phaco {
+
+namespace {
+SystemCost cost_of(const SystemTiming& t) {
+  SystemCost c{t.name, t.p50_ms(), t.p99_ms(), 0.0};
+  if (!t.samples_ms.empty()) {
+    c.mean_ms = std::accumulate(t.samples_ms.begin(), t.samples_ms.end(), 0.0) /
+                static_cast<double>(t.samples_ms.size());
+  }
+  return c;
+}
+}  // namespace
+
+double peak_memory_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
+  auto scene = build_scene(scenario, options);
+  const uint64_t frames = scenario.frame_count();
+  Stopwatch wall;
+  for (uint64_t f = 0; f < frames; ++f) step(*scene);
+
+  RunReport r;
+  r.wall_time_s = wall.elapsed_s();
+  r.scenario = scenario.source;
+  r.drill = std::string(to_string(scenario.drill));
+  r.frames = frames;
+  r.sim_time_s = scene->time_s;
+  r.threads = scene->executor->threads();
+  r.dt_s = scenario.dt_s;
+  for (const auto& t : scene->executor->timings()) r.systems.push_back(cost_of(t));
+  r.frame = cost_of(scene->executor->frame_timing());
+  r.frame.name = "frame";
+  r.mesh_load_s = scene->mesh_load_s;
+  r.elements = element_counts(*scene);
+  r.state_hash = state_hash(*scene);
+  r.peak_memory_mb = peak_memory_mb();
+  return r;
+}
+
+nlohmann::json to_json(const RunReport& r) {
+  nlohmann::json j;
+  j["scenario"] = r.scenario;
+  j["drill"] = r.drill;
+  j["sim_time_s"] = r.sim_time_s;
+  j["dt_s"] = r.dt_s;
+  j["frames"] = r.frames;
+  j["threads"] = r.threads;
+  nlohmann::json systems = nlohmann::json::object();
+  for (const auto& s : r.systems) {
+    systems[s.name] = {{"p50_ms", s.p50_ms}, {"p99_ms", s.p99_ms}, {"mean_ms", s.mean_ms}};
+  }
+  j["systems"] = systems;
+  j["frame"] = {{"p50_ms", r.frame.p50_ms}, {"p99_ms", r.frame.p99_ms}, {"mean_ms", r.frame.mean_ms}};
+  j["wall_time_s"] = r.wall_time_s;
+  j["mesh_load_s"] = r.mesh_load_s;
+  j["peak_memory_mb"] = r.peak_memory_mb;
+  nlohmann::json elements = nlohmann::json::object();
+  for (const auto& [k, v] : r.elements) elements[k] = v;
+  j["elements"] = elements;
+  j["metrics"] = r.metrics;
+  j["events"] = r.events;
+  j["state_hash"] = r.state_hash;
+  return j;
+}
+
+std::string summary_text(const RunReport& r) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%s  drill %s  %llu frames (%.3f s simulated at dt %.6f s)  %d thread(s)\n",
+                r.scenario.c_str(), r.drill.c_str(), static_cast<unsigned long long>(r.frames),
+                r.sim_time_s, r.dt_s, r.threads);
+  out += line;
+  std::snprintf(line, sizeof line, "frame   p50 %.4f ms  p99 %.4f ms   (stepping took %.3f s wall, meshes %.3f s)\n",
+                r.frame.p50_ms, r.frame.p99_ms, r.wall_time_s, r.mesh_load_s);
+  out += line;
+  for (const auto& s : r.systems) {
+    std::snprintf(line, sizeof line, "  %-22s p50 %.4f ms  p99 %.4f ms\n", s.name.c_str(), s.p50_ms, s.p99_ms);
+    out += line;
+  }
+  out += "elements:";
+  for (const auto& [k, v] : r.elements) out += " " + k + "=" + std::to_string(v);
+  std::snprintf(line, sizeof line, "\npeak memory %.1f MiB   metrics %zu   events %zu   state hash %s\n",
+                r.peak_memory_mb, r.metrics.size(), r.events.size(), r.state_hash.c_str());
+  out += line;
+  return out;
+}
+
+}  // namespace phaco

@@ -1,0 +1,42 @@
+#pragma once
+// Runs a scenario headless for its duration at the fixed step and collects the report of
+// issue 2 / DESIGN.md §7: what ran, how long each system took, how big the scene was, and the
+// state hash that ties the figures to a reproducible run.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "procedures/scene/scene.hpp"
+
+namespace phaco {
+
+struct SystemCost {
+  std::string name;
+  double p50_ms = 0, p99_ms = 0, mean_ms = 0;
+};
+
+struct RunReport {
+  std::string scenario;  // file
+  std::string drill;
+  double sim_time_s = 0;
+  uint64_t frames = 0;
+  int threads = 1;
+  double dt_s = 0;
+  std::vector<SystemCost> systems;
+  SystemCost frame;          // the whole frame
+  double wall_time_s = 0;    // stepping only
+  double mesh_load_s = 0;    // meshes loaded from the cache or generated
+  double peak_memory_mb = 0;
+  std::vector<std::pair<std::string, uint64_t>> elements;
+  nlohmann::json metrics = nlohmann::json::object();  // filled by the drills (issue 7)
+  nlohmann::json events = nlohmann::json::array();
+  std::string state_hash;
+};
+
+RunReport run_scenario(const Scenario& scenario, const SceneOptions& options);
+nlohmann::json to_json(const RunReport& report);
+std::string summary_text(const RunReport& report);
+// Peak resident set size of this process so far, MiB.
+double peak_memory_mb();
+
+}  // namespace phaco

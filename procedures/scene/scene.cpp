@@ -1,0 +1,289 @@
+#include "procedures/scene/scene.hpp"
+
+#include <algorithm>
+
+#include "components/particles.hpp"
+#include "components/tets.hpp"
+#include "components/tool.hpp"
+#include "components/triangles.hpp"
+#include "engine/core/clock.hpp"
+#include "engine/core/error.hpp"
+#include "engine/core/state_hash.hpp"
+#include "engine/io/mesh_obj.hpp"
+#include "procedures/eye/eye_mesh.hpp"
+#include "procedures/eye/mesh_cache.hpp"
+#include "systems/tool_motion/tool_motion.hpp"
+
+namespace phaco {
+
+namespace {
+
+constexpr double kKgPerMm3PerKgPerM3 = 1e-9;  // density kg/m³ → kg/mm³
+
+std::vector<std::string> to_strings(std::span<const char* const> names) {
+  return {names.begin(), names.end()};
+}
+
+eye::EyeParams load_params(const Scenario& s) {
+  eye::EyeParams params = s.eye.params_file ? eye::load_eye_params(*s.eye.params_file)
+                                            : eye::default_eye_params();
+  for (const auto& [key, value] : s.eye.overrides) {
+    try {
+      eye::apply_override(params, key, value);
+    } catch (const InputError& e) {
+      throw InputError(s.source + ": eye.overrides." + key + ": " + e.what());
+    }
+  }
+  return params;
+}
+
+const SurfaceMesh& surface_of(const eye::EyeMeshes& m, BodyPart part) {
+  switch (part) {
+    case BodyPart::Cornea: return m.cornea;
+    case BodyPart::Capsule: return m.capsule;
+    case BodyPart::Iris: return m.iris;
+    case BodyPart::Globe: return m.globe;
+    default: return m.lens_surface;
+  }
+}
+
+// Lumped mass of a membrane: each triangle gives a third of ρ·h·A to each corner.
+std::vector<double> membrane_masses(const SurfaceMesh& mesh, double density_kg_m3, double thickness_mm) {
+  std::vector<double> mass(mesh.vertices.size(), 0.0);
+  for (const auto& t : mesh.triangles) {
+    const Vec3& a = mesh.vertices[t[0]];
+    const double area = 0.5 * (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm();
+    const double m = density_kg_m3 * kKgPerMm3PerKgPerM3 * thickness_mm * area / 3.0;
+    for (uint32_t v : t) mass[v] += m;
+  }
+  return mass;
+}
+
+// Vertices on an open membrane's rim: the capsule is held there by the zonules.
+std::vector<uint8_t> rim_vertices(const SurfaceMesh& mesh) {
+  std::vector<std::pair<uint64_t, int>> edges;
+  edges.reserve(mesh.triangles.size() * 3);
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = t[k], b = t[(k + 1) % 3];
+      edges.push_back({(uint64_t{std::min(a, b)} << 32) | std::max(a, b), 1});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint8_t> rim(mesh.vertices.size(), 0);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 1) {
+      rim[edges[i].first >> 32] = 1;
+      rim[edges[i].first & 0xFFFFFFFFu] = 1;
+    }
+    i = j;
+  }
+  return rim;
+}
+
+Particles make_particles(const std::vector<Vec3>& vertices) {
+  Particles p;
+  table_append(p, static_cast<uint32_t>(vertices.size()));
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    p.x[i] = static_cast<float>(vertices[i].x());
+    p.y[i] = static_cast<float>(vertices[i].y());
+    p.z[i] = static_cast<float>(vertices[i].z());
+    p.kind[i] = ParticleKind::Anchored;  // rigid until a system frees it
+  }
+  return p;
+}
+
+Triangles make_triangles(const SurfaceMesh& mesh) {
+  Triangles t;
+  table_append(t, static_cast<uint32_t>(mesh.triangles.size()));
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    t.a[i] = mesh.triangles[i][0];
+    t.b[i] = mesh.triangles[i][1];
+    t.c[i] = mesh.triangles[i][2];
+  }
+  return t;
+}
+
+Tets make_tets(const TetMesh& mesh) {
+  Tets t;
+  table_append(t, static_cast<uint32_t>(mesh.tets.size()));
+  for (size_t i = 0; i < mesh.tets.size(); ++i) {
+    t.a[i] = mesh.tets[i][0];
+    t.b[i] = mesh.tets[i][1];
+    t.c[i] = mesh.tets[i][2];
+    t.d[i] = mesh.tets[i][3];
+    t.region[i] = i < mesh.region.size() ? mesh.region[i] : 0;
+  }
+  return t;
+}
+
+void add_body(Scene& scene, BodyPart part, const eye::EyeMeshes& meshes) {
+  const Entity e = scene.world.create(EntityKind::Body, std::string(to_string(part)));
+  scene.world.add(e, Body{part});
+  if (part == BodyPart::Lens) {
+    scene.world.add(e, make_particles(meshes.lens_tets->vertices));
+    scene.world.add(e, make_tets(*meshes.lens_tets));
+  } else {
+    const SurfaceMesh& mesh = surface_of(meshes, part);
+    Particles particles = make_particles(mesh.vertices);
+    if (part == BodyPart::Capsule) {
+      const auto mass = membrane_masses(mesh, scene.params.get("capsule.density_kg_m3"),
+                                        scene.params.get("capsule.thickness_mm"));
+      const auto rim = rim_vertices(mesh);
+      for (size_t i = 0; i < mass.size(); ++i) {
+        particles.kind[i] = rim[i] ? ParticleKind::Anchored : ParticleKind::Free;
+        particles.inv_mass[i] = rim[i] || mass[i] <= 0 ? 0.0f : static_cast<float>(1.0 / mass[i]);
+      }
+    }
+    scene.world.add(e, std::move(particles));
+    scene.world.add(e, make_triangles(mesh));
+  }
+  scene.bodies.push_back(e);
+}
+
+void replace_meshes_from_files(const Scenario& s, eye::EyeMeshes& meshes) {
+  for (const auto& [name, path] : s.eye.meshes) {
+    SurfaceMesh* target = name == "cornea"         ? &meshes.cornea
+                          : name == "capsule"      ? &meshes.capsule
+                          : name == "iris"         ? &meshes.iris
+                          : name == "globe"        ? &meshes.globe
+                          : name == "lens_surface" ? &meshes.lens_surface
+                                                   : nullptr;
+    if (!target) throw InputError(s.source + ": eye.meshes." + name + ": unknown body");
+    try {
+      *target = read_obj(path);
+    } catch (const InputError& e) {
+      throw InputError(s.source + ": eye.meshes." + name + ": " + e.what());
+    }
+  }
+}
+
+std::vector<SystemDesc> base_systems(Scene& scene) {
+  std::vector<SystemDesc> systems;
+  systems.push_back({.name = "move_tools",
+                     .phase = Phase::Input,
+                     .reads = to_strings(tool_motion::kReads),
+                     .writes = to_strings(tool_motion::kWrites),
+                     .run = [&scene](const FrameContext& ctx) {
+                       const double t_end = ctx.time_s + ctx.dt_s;
+                       for (Entity e : scene.tools) {
+                         tool_motion::move_tool(scene.world.at<ToolTrack>(e), scene.world.at<ToolState>(e),
+                                                t_end);
+                       }
+                     }});
+  // The frame's one sync point for structural change (DESIGN.md §4, step 3).
+  systems.push_back({.name = "apply_commands",
+                     .phase = Phase::Topology,
+                     .writes = {"world.structure"},
+                     .barrier = true,
+                     .run = [&scene](const FrameContext&) { scene.commands.apply(scene.world); }});
+  return systems;
+}
+
+}  // namespace
+
+std::vector<BodyPart> bodies_for(Drill drill) {
+  switch (drill) {
+    case Drill::CornealIncision: return {BodyPart::Cornea, BodyPart::Iris, BodyPart::Globe};
+    case Drill::Capsulorhexis:
+      return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::LensSurface};
+    case Drill::PhacoSculpting: return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::Lens};
+  }
+  return {};
+}
+
+std::optional<Entity> Scene::body(BodyPart part) const {
+  for (Entity e : bodies) {
+    if (const Body* b = world.get<Body>(e); b && b->part == part) return e;
+  }
+  return std::nullopt;
+}
+
+std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions& options) {
+  auto scene = std::make_unique<Scene>();
+  scene->scenario = scenario;
+  scene->params = load_params(scenario);
+  scene->resolution = eye::resolution_for_level(scenario.eye.level);
+  scene->commands = CommandQueues(options.threads);
+
+  const auto parts = bodies_for(scenario.drill);
+  const bool need_tets = std::find(parts.begin(), parts.end(), BodyPart::Lens) != parts.end();
+  const auto layout = scenario.eye.capsule_layout == "isotropic" ? eye::CapsuleLayout::Isotropic
+                                                                  : eye::CapsuleLayout::Curvilinear;
+  Stopwatch mesh_clock;
+  eye::MeshCache cache(options.cache_dir.value_or(eye::MeshCache::default_dir()));
+  eye::EyeMeshes meshes = cache.load_or_build(scene->params, scene->resolution, layout, need_tets);
+  replace_meshes_from_files(scenario, meshes);
+  scene->mesh_load_s = mesh_clock.elapsed_s();
+
+  for (BodyPart part : parts) add_body(*scene, part, meshes);
+  for (const HandTrack& hand : scenario.hands) {
+    const Entity e = scene->world.create(EntityKind::Tool, std::string(to_string(hand.hand)) + "." +
+                                                               std::string(to_string(hand.tool)));
+    scene->world.add(e, Tool{hand.tool, hand.hand});
+    scene->world.add(e, ToolTrack{hand.track});
+    scene->world.add(e, sample_track(hand.track, 0.0));
+    scene->tools.push_back(e);
+  }
+
+  std::vector<SystemDesc> systems = base_systems(*scene);
+  if (options.extra_systems) {
+    for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));
+  }
+  scene->graph = std::make_unique<FrameGraph>(std::move(systems));
+  scene->executor = std::make_unique<Executor>(*scene->graph, options.threads);
+  return scene;
+}
+
+void step(Scene& scene) {
+  const FrameContext ctx{scene.frame, scene.time_s, scene.scenario.dt_s};
+  scene.executor->run_frame(ctx);
+  ++scene.frame;
+  // Time from the frame count, not by accumulation, so it does not drift over long runs.
+  scene.time_s = static_cast<double>(scene.frame) * scene.scenario.dt_s;
+}
+
+std::string state_hash(const Scene& scene) {
+  StateHash h;
+  auto& world = const_cast<World&>(scene.world);  // read-only walk; each() is non-const
+  for (Entity e : scene.bodies) {
+    h.add_string(world.name(e));
+    if (const Particles* p = world.get<Particles>(e)) {
+      h.add(p->slots.alive_mask());
+      for (const auto* col : {&p->x, &p->y, &p->z, &p->vx, &p->vy, &p->vz, &p->inv_mass}) {
+        h.add(std::span<const float>(*col));
+      }
+    }
+    if (const Triangles* t = world.get<Triangles>(e)) {
+      h.add(t->slots.alive_mask());
+      for (const auto* col : {&t->a, &t->b, &t->c}) h.add(std::span<const uint32_t>(*col));
+    }
+    if (const Tets* t = world.get<Tets>(e)) {
+      h.add(t->slots.alive_mask());
+      for (const auto* col : {&t->a, &t->b, &t->c, &t->d}) h.add(std::span<const uint32_t>(*col));
+    }
+  }
+  for (Entity e : scene.tools) {
+    const ToolState& s = world.at<ToolState>(e);
+    const double v[] = {s.pos.x(), s.pos.y(), s.pos.z(), s.quat.w(), s.quat.x(), s.quat.y(),
+                        s.quat.z(), s.grip, s.pedal};
+    h.add(std::span<const double>(v));
+  }
+  return h.hex();
+}
+
+std::vector<std::pair<std::string, uint64_t>> element_counts(const Scene& scene) {
+  std::vector<std::pair<std::string, uint64_t>> out;
+  for (Entity e : scene.bodies) {
+    const std::string& name = scene.world.name(e);
+    if (const auto* p = scene.world.get<Particles>(e)) out.push_back({name + ".particles", p->slots.live_count()});
+    if (const auto* t = scene.world.get<Triangles>(e)) out.push_back({name + ".triangles", t->slots.live_count()});
+    if (const auto* t = scene.world.get<Tets>(e)) out.push_back({name + ".tets", t->slots.live_count()});
+  }
+  out.push_back({"tools", scene.tools.size()});
+  return out;
+}
+
+}  // namespace phaco

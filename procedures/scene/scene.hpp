@@ -1,0 +1,68 @@
+#pragma once
+// A scene: the World a drill needs (bodies of the eye, tools with their tracks), its per-frame
+// task graph and the executor that runs it. Built once from a scenario; stepped at the fixed dt.
+//
+// Which bodies a drill loads (model no more than the scene needs, DESIGN.md §3):
+//   corneal_incision: cornea, iris, globe              (no lens at all)
+//   capsulorhexis:    cornea, capsule, iris, lens_surface
+//   phaco_sculpting:  cornea, capsule, iris, lens (tetrahedra)
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "components/body.hpp"
+#include "engine/ecs/command_buffer.hpp"
+#include "engine/ecs/world.hpp"
+#include "engine/io/scenario.hpp"
+#include "engine/schedule/executor.hpp"
+#include "engine/schedule/frame_graph.hpp"
+#include "procedures/eye/eye_params.hpp"
+#include "procedures/eye/resolution.hpp"
+
+namespace phaco {
+
+struct Scene;
+
+struct SceneOptions {
+  int threads = 1;
+  std::optional<std::filesystem::path> cache_dir;  // default: MeshCache::default_dir()
+  // Extra systems (tests, tools): called once the bodies exist, before the graph is built.
+  std::function<std::vector<SystemDesc>(Scene&)> extra_systems;
+};
+
+struct Scene {
+  Scenario scenario;
+  eye::EyeParams params;
+  eye::Resolution resolution;
+  World world;
+  std::vector<Entity> bodies;  // in creation order
+  std::vector<Entity> tools;
+  CommandQueues commands;
+  std::unique_ptr<FrameGraph> graph;
+  std::unique_ptr<Executor> executor;
+  uint64_t frame = 0;
+  double time_s = 0;
+  double mesh_load_s = 0;  // wall time to load or build the meshes
+
+  std::optional<Entity> body(BodyPart part) const;
+};
+
+std::vector<BodyPart> bodies_for(Drill drill);
+
+// Throws InputError naming the scenario file and field for bad eye parameters or mesh files.
+std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions& options);
+
+// One fixed step: runs the frame graph once.
+void step(Scene& scene);
+
+// Hash of every body's elements and every tool's pose (bit-exact; equal for any thread count).
+std::string state_hash(const Scene& scene);
+
+// Element counts per kind, e.g. "capsule.particles", "lens.tets".
+std::vector<std::pair<std::string, uint64_t>> element_counts(const Scene& scene);
+
+}  // namespace phaco

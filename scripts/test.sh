@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The README's second command (and what .ci/run calls): installs what is needed, builds, and
+# runs every test; then builds the ASan+UBSan configuration and runs every test again under it
+# (skip that with PHACO_SKIP_SANITIZERS=1 for a quick local run). TSan is a preset but not run
+# here: Debian's libtbb is not instrumented, so TSan reports oneTBB's own hand-offs as races.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+jobs="${PHACO_JOBS:-$(nproc)}"
+"$root/scripts/install-deps.sh"
+
+build="$root/build/release"
+PHACO_BUILD_DIR="$build" "$root/scripts/build.sh"
+# Tests build their meshes into a cache inside the build tree, never into the user's home.
+export PHACO_CACHE_DIR="$build/mesh-cache"
+ctest --test-dir "$build" --output-on-failure -j "$jobs"
+
+if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
+  asan="$root/build/asan"
+  cmake -S "$root" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHACO_SANITIZE=address \
+    -DPHACO_BUILD_BENCHMARKS=OFF >/dev/null
+  cmake --build "$asan" -j "$jobs"
+  PHACO_CACHE_DIR="$asan/mesh-cache" ctest --test-dir "$asan" --output-on-failure -j "$jobs"
+fi

@@ -1,0 +1,143 @@
+// The `phaco` executable as a user meets it: exit codes 0 / 2 / 1 and messages that name the problem.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result phaco(const std::string& args) {
+  const std::string cmd = std::string(PHACO_BIN) + " " + args + " 2>&1";
+  Result r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) r.output.append(buf, n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("phaco-cli-" + name + "-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+fs::path write(const fs::path& dir, const std::string& name, const std::string& text) {
+  std::ofstream(dir / name) << text;
+  return dir / name;
+}
+
+const std::string kSmall = R"({ "drill": "capsulorhexis", "eye": { "level": 0 }, "dt_s": 0.01, "duration_s": 0.2,
+  "hands": { "right": { "tool": "cystotome", "track": [ { "t": 0, "pos": [0, 0, 3.5], "quat": [1, 0, 0, 0] },
+                                                      { "t": 0.2, "pos": [0, 0, 2], "quat": [1, 0, 0, 0] } ] } } })";
+
+TEST(Cli, HelpAndVersionSucceed) {
+  const Result help = phaco("--help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.output.find("phaco run FILE"), std::string::npos);
+  EXPECT_EQ(phaco("run --help").code, 0);
+  EXPECT_EQ(phaco("--version").code, 0);
+}
+
+TEST(Cli, UsageErrorsAreBadInput) {
+  EXPECT_EQ(phaco("").code, 2);
+  const Result unknown = phaco("frobnicate");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.output.find("unknown command 'frobnicate'"), std::string::npos);
+  EXPECT_EQ(phaco("run").code, 2);
+  const Result opt = phaco("run x.json --fast");
+  EXPECT_EQ(opt.code, 2);
+  EXPECT_NE(opt.output.find("unknown option '--fast'"), std::string::npos);
+  EXPECT_EQ(phaco("mesh --level 9 --out /tmp/x").code, 2);
+  EXPECT_EQ(phaco("mesh --level 1").code, 2) << "--out is required";
+}
+
+TEST(Cli, ValidateNamesFileAndField) {
+  const fs::path dir = temp_dir("validate");
+  const fs::path good = write(dir, "good.json", kSmall);
+  std::string bad_text = kSmall;
+  bad_text.replace(bad_text.find("capsulorhexis"), 13, "capsulotomy");
+  const fs::path bad = write(dir, "bad.json", bad_text);
+  EXPECT_EQ(phaco("validate " + good.string()).code, 0);
+  const Result r = phaco("validate " + good.string() + " " + bad.string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.json: drill: unknown drill 'capsulotomy'"), std::string::npos) << r.output;
+  const Result missing = phaco("validate " + (dir / "nope.json").string());
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.output.find("nope.json"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(Cli, RunWritesReportAndIsThreadIndependent) {
+  const fs::path dir = temp_dir("run");
+  const fs::path scen = write(dir, "small.json", kSmall);
+  const std::string cache = " --cache-dir " + (dir / "cache").string();
+  const Result one = phaco("run " + scen.string() + " --threads 1 --report " + (dir / "r1.json").string() + cache);
+  ASSERT_EQ(one.code, 0) << one.output;
+  const Result two = phaco("run " + scen.string() + " --threads 2 --report " + (dir / "r2.json").string() + cache);
+  ASSERT_EQ(two.code, 0) << two.output;
+  const auto r1 = nlohmann::json::parse(std::ifstream(dir / "r1.json"));
+  const auto r2 = nlohmann::json::parse(std::ifstream(dir / "r2.json"));
+  EXPECT_EQ(r1["frames"], 20);
+  EXPECT_EQ(r1["threads"], 1);
+  EXPECT_EQ(r2["threads"], 2);
+  EXPECT_EQ(r1["state_hash"], r2["state_hash"]);
+  const Result json = phaco("run " + scen.string() + " --json" + cache);
+  ASSERT_EQ(json.code, 0);
+  EXPECT_EQ(nlohmann::json::parse(json.output)["state_hash"], r1["state_hash"]);
+  EXPECT_EQ(phaco("run " + scen.string() + " --threads 0" + cache).code, 2);
+  EXPECT_EQ(phaco("run " + scen.string() + " --threads many" + cache).code, 2);
+  const Result unwritable = phaco("run " + scen.string() + " --report /nonexistent-dir/r.json" + cache);
+  EXPECT_EQ(unwritable.code, 2);
+  EXPECT_NE(unwritable.output.find("/nonexistent-dir/r.json"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(Cli, RunRejectsBadScenarioWithExitTwo) {
+  const fs::path dir = temp_dir("runbad");
+  std::string text = kSmall;
+  text.replace(text.find("\"t\": 0.2"), 8, "\"t\": -1.0");
+  const fs::path scen = write(dir, "unsorted.json", text);
+  const Result r = phaco("run " + scen.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("unsorted.json: hands.right.track[1].t"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, MeshWritesEveryBody) {
+  const fs::path dir = temp_dir("mesh");
+  const Result r = phaco("mesh --level 0 --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f : {"cornea.obj", "capsule.obj", "iris.obj", "globe.obj", "lens_surface.obj", "lens.node", "lens.ele"}) {
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+    EXPECT_GT(fs::file_size(dir / f), 100u) << f;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Cli, GraphPrintsDot) {
+  const fs::path dir = temp_dir("graph");
+  const fs::path scen = write(dir, "small.json", kSmall);
+  const Result r = phaco("graph " + scen.string() + " --cache-dir " + (dir / "cache").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("digraph"), std::string::npos);
+  EXPECT_NE(r.output.find("move_tools"), std::string::npos);
+  EXPECT_NE(r.output.find("apply_commands"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+}  // namespace
