@@ -186,11 +186,11 @@ int foundation(const std::vector<std::string>& args) {
         ", the bodies loaded but no physics systems yet (tools follow their tracks; the topology sync point applies "
         "an empty command queue). This is the scheduler's own overhead per frame: the floor under every later "
         "figure. Best p50 of " + std::to_string(repeats) + " runs.\n\n";
-  md += "| threads | frames | frame p50 (ms) | frame p99 (ms) | frame mean (ms) | state hash |\n";
+  md += "| threads | frames | frame p50 (µs) | frame p99 (µs) | frame mean (µs) | state hash |\n";
   md += "|---:|---:|---:|---:|---:|---|\n";
   for (const auto& s : scenes) {
-    md += "| " + std::to_string(s.threads) + " | " + std::to_string(s.frames) + " | " + fmt("%.4f", s.frame_p50_ms) +
-          " | " + fmt("%.4f", s.frame_p99_ms) + " | " + fmt("%.4f", s.mean_ms) + " | `" + s.hash + "` |\n";
+    md += "| " + std::to_string(s.threads) + " | " + std::to_string(s.frames) + " | " + fmt("%.2f", 1e3 * s.frame_p50_ms) +
+          " | " + fmt("%.2f", 1e3 * s.frame_p99_ms) + " | " + fmt("%.2f", 1e3 * s.mean_ms) + " | `" + s.hash + "` |\n";
   }
   const bool same = scenes.size() == 2 && scenes[0].hash == scenes[1].hash;
   md += same ? "\nThe state hash is equal for 1 and 2 threads: the run is bit-identical whatever the thread count.\n"
