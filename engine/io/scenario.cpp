@@ -68,7 +68,8 @@ class ScenarioParser {
       r_.fail("$", "expected a JSON object at the top level, got " + io::describe_value(root));
     }
     r_.expect_object(
-        root, "$", {"name", "description", "drill", "eye", "dt_s", "seed", "duration_s", "hands"});
+        root, "$",
+        {"name", "description", "drill", "eye", "methods", "dt_s", "seed", "duration_s", "hands"});
     Scenario s;
     s.source = r_.source();
     if (const json* v = JsonReader::find(root, "name")) s.name = r_.string(*v, "name");
@@ -78,6 +79,7 @@ class ScenarioParser {
     s.drill = static_cast<Drill>(
         choice(r_.require(root, "$", "drill", one_of(kDrillNames)), "drill", kDrillNames, "drill"));
     if (const json* v = JsonReader::find(root, "eye")) s.eye = eye(*v, "eye");
+    if (const json* v = JsonReader::find(root, "methods")) s.methods = methods(*v, "methods");
 
     if (const json* v = JsonReader::find(root, "dt_s")) {
       s.dt_s = r_.number(*v, "dt_s");
@@ -124,6 +126,24 @@ class ScenarioParser {
       r_.fail(path, "unknown " + std::string(what) + " '" + name + "'; expected " + one_of(names));
     }
     return *index;
+  }
+
+  // "body.setting": "choice" — which method a body uses; names are checked by the scene builder.
+  std::map<std::string, std::string> methods(const json& v, const std::string& path) const {
+    if (!v.is_object()) {
+      r_.fail(path, "expected an object of \"body.setting\": \"choice\" (e.g. \"capsule.integrator\": "
+                    "\"implicit_euler\"), got " + io::describe_value(v));
+    }
+    std::map<std::string, std::string> out;
+    for (const auto& [key, value] : v.items()) {
+      const std::string kpath = path_key(path, key);
+      if (!is_override_key(key)) {
+        r_.fail(kpath, "method key must have the form 'body.setting' (e.g. 'capsule.integrator'), got '" +
+                           key + "'");
+      }
+      out[key] = r_.string(value, kpath);
+    }
+    return out;
   }
 
   EyeSpec eye(const json& v, const std::string& path) const {
@@ -302,7 +322,7 @@ bool operator==(const TrackSample& a, const TrackSample& b) {
 
 bool operator==(const Scenario& a, const Scenario& b) {
   return a.name == b.name && a.description == b.description && a.drill == b.drill &&
-         a.eye == b.eye && a.dt_s == b.dt_s && a.seed == b.seed && a.duration_s == b.duration_s &&
+         a.eye == b.eye && a.methods == b.methods && a.dt_s == b.dt_s && a.seed == b.seed && a.duration_s == b.duration_s &&
          a.hands == b.hands;
 }
 
@@ -355,6 +375,7 @@ json to_json(const Scenario& s) {
     eye["meshes"] = std::move(meshes);
   }
   j["eye"] = std::move(eye);
+  if (!s.methods.empty()) j["methods"] = s.methods;
   j["dt_s"] = s.dt_s;
   j["seed"] = s.seed;
   j["duration_s"] = s.duration_s;

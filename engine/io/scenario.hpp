@@ -57,6 +57,9 @@ struct Scenario {
   std::string source;  // file path as given, for messages; not part of equality
   std::string name, description;
   Drill drill = Drill::Capsulorhexis;
+  // Per-body method choices, "body.setting" -> name, e.g. "capsule.integrator" -> "implicit_euler";
+  // the scene builder checks the names.
+  std::map<std::string, std::string> methods;
   EyeSpec eye;
   double dt_s = 1.0 / 120.0;  // s, fixed simulation step
   uint64_t seed = 0;

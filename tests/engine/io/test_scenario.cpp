@@ -153,6 +153,18 @@ TEST(Scenario, DefaultsAndOptionalFields) {
   EXPECT_EQ(m.seed, 0u);
   EXPECT_EQ(m.frame_count(), 1200u);
   EXPECT_FALSE(m.eye.params_file.has_value());
+  EXPECT_TRUE(m.methods.empty());
+
+  // Method choices are kept verbatim (names are the scene's to check) and survive a round trip.
+  const Scenario with_methods = parse_scenario(
+      R"({"drill": "capsulorhexis", "duration_s": 1,
+          "methods": {"capsule.integrator": "xpbd", "capsule.spring_law": "quadratic"},
+          "hands": {"left": {"tool": "forceps", "track": [{"t": 0, "pos": [0, 0, 3]}]}}})",
+      "methods.json", dir);
+  EXPECT_EQ(with_methods.methods.at("capsule.integrator"), "xpbd");
+  EXPECT_EQ(with_methods.methods.size(), 2u);
+  const Scenario methods_back = parse_scenario(to_json(with_methods).dump(), "back.json", dir);
+  EXPECT_TRUE(methods_back == with_methods);
   fs::remove_all(dir);
 }
 
@@ -202,7 +214,7 @@ const std::vector<BadCase> kBadCases = {
      {"unknown_hand.json: hands.middle: unknown hand 'middle'; expected one of: left, right"}},
     {"unknown_field_root.json",
      {"unknown_field_root.json: seeds: unknown field 'seeds'; expected one of: name, description, "
-      "drill, eye, dt_s, seed, duration_s, hands"}},
+      "drill, eye, methods, dt_s, seed, duration_s, hands"}},
     {"unknown_field_eye.json",
      {"unknown_field_eye.json: eye.levle: unknown field 'levle'; expected one of: level, "
       "capsule_layout, overrides, params, meshes"}},
@@ -297,6 +309,12 @@ const std::vector<BadCase> kBadCases = {
      {"hands_array.json: hands: expected an object with a \"left\" and/or \"right\" hand, got an "
       "array of 1 element"}},
     {"empty.json", {"empty.json: $: file is empty; expected a JSON object"}},
+    {"methods_not_object.json",
+     {"methods_not_object.json: methods: expected an object of \"body.setting\": \"choice\""}},
+    {"methods_key_without_body.json",
+     {"methods_key_without_body.json: methods.integrator: method key must have the form 'body.setting'"}},
+    {"methods_value_not_string.json",
+     {"methods_value_not_string.json: methods[\"capsule.integrator\"]: expected a string"}},
     {"top_level_array.json",
      {"top_level_array.json: $: expected a JSON object at the top level, got an array of 1 "
       "element"}},

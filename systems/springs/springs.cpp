@@ -1,0 +1,148 @@
+#include "systems/springs/springs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "engine/core/math.hpp"
+#include "engine/schedule/parallel.hpp"
+
+namespace phaco::springs {
+
+namespace {
+
+struct EdgeRecord {
+  uint32_t i, j;
+  double area;  // sum of the areas of the triangles sharing the edge, mm²
+};
+
+double triangle_area(const Particles& p, uint32_t a, uint32_t b, uint32_t c) {
+  const Vec3 pa(p.x[a], p.y[a], p.z[a]), pb(p.x[b], p.y[b], p.z[b]), pc(p.x[c], p.y[c], p.z[c]);
+  return 0.5 * (pb - pa).cross(pc - pa).norm();
+}
+
+}  // namespace
+
+Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& m) {
+  if (!(m.prestretch >= 0.0 && m.prestretch < 1.0)) throw std::invalid_argument("prestretch must be in [0, 1)");
+  std::vector<EdgeRecord> edges;
+  edges.reserve(triangles.slots.size() * 3);
+  for (uint32_t t = 0; t < triangles.slots.size(); ++t) {
+    if (!triangles.slots.alive(t)) continue;
+    const uint32_t v[3] = {triangles.a[t], triangles.b[t], triangles.c[t]};
+    const double area = triangle_area(particles, v[0], v[1], v[2]);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = v[k], b = v[(k + 1) % 3];
+      edges.push_back({std::min(a, b), std::max(a, b), area});
+    }
+  }
+  std::sort(edges.begin(), edges.end(),
+            [](const EdgeRecord& x, const EdgeRecord& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+
+  Springs s;
+  const double equilateral = std::sqrt(3.0) / 2.0;
+  for (size_t e = 0; e < edges.size();) {
+    double area = 0.0;
+    size_t f = e;
+    for (; f < edges.size() && edges[f].i == edges[e].i && edges[f].j == edges[e].j; ++f) area += edges[f].area;
+    const uint32_t a = edges[e].i, b = edges[e].j;
+    const double dx = particles.x[b] - particles.x[a], dy = particles.y[b] - particles.y[a],
+                 dz = particles.z[b] - particles.z[a];
+    const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
+    double k = m.sheet_modulus_mn_mm *
+               (m.weighting == StiffnessWeighting::AreaWeighted && l > 0 ? area / (l * l) : equilateral);
+    if (m.law == SpringLaw::Quadratic) k /= m.quadratic_reference_mm;
+    const uint32_t idx = table_add(s);
+    s.i[idx] = a;
+    s.j[idx] = b;
+    s.rest_length[idx] = static_cast<float>((1.0 - m.prestretch) * l);
+    s.stiffness[idx] = static_cast<float>(k);
+    e = f;
+  }
+  return s;
+}
+
+SpringBlocks plan_blocks(const Springs& s, uint32_t particle_count, uint32_t target_blocks) {
+  uint32_t max_span = 0;
+  for (uint32_t e = 0; e < s.slots.size(); ++e) {
+    if (s.j[e] < s.i[e]) throw std::invalid_argument("plan_blocks: springs must have i < j");
+    if (e > 0 && s.i[e] < s.i[e - 1]) throw std::invalid_argument("plan_blocks: springs must be sorted by i");
+    max_span = std::max(max_span, s.j[e] - s.i[e]);
+  }
+  const uint32_t n = std::max<uint32_t>(particle_count, 1);
+  const uint32_t by_target = (n + std::max<uint32_t>(target_blocks, 1) - 1) / std::max<uint32_t>(target_blocks, 1);
+  const uint32_t block_size = std::max(by_target, max_span + 1);
+  SpringBlocks b;
+  for (uint32_t start = 0; start < n; start += block_size) b.particle_begin.push_back(start);
+  b.particle_begin.push_back(n);
+  for (uint32_t k = 0; k < b.particle_begin.size(); ++k) {
+    const auto it = std::lower_bound(s.i.begin(), s.i.end(), b.particle_begin[k]);
+    b.spring_begin.push_back(k + 1 == b.particle_begin.size() ? s.slots.size()
+                                                               : static_cast<uint32_t>(it - s.i.begin()));
+  }
+  return b;
+}
+
+namespace {
+
+inline void spring_range(const Springs& s, uint32_t begin, uint32_t end, SpringLaw law, const Particles& p,
+                         Forces& f) {
+  for (uint32_t e = begin; e < end; ++e) {
+    const uint32_t i = s.i[e], j = s.j[e];
+    const float dx = p.x[j] - p.x[i], dy = p.y[j] - p.y[i], dz = p.z[j] - p.z[i];
+    const float l = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (l <= 0.0f) continue;  // coincident ends: no direction, no force
+    const float ext = l - s.rest_length[e];
+    const float mag = law == SpringLaw::Linear ? s.stiffness[e] * ext : s.stiffness[e] * ext * std::fabs(ext);
+    const float scale = mag / l;
+    const float fx = scale * dx, fy = scale * dy, fz = scale * dz;
+    f.fx[i] += fx, f.fy[i] += fy, f.fz[i] += fz;
+    f.fx[j] -= fx, f.fy[j] -= fy, f.fz[j] -= fz;
+  }
+}
+
+}  // namespace
+
+void add_spring_forces(const Springs& s, const SpringBlocks& blocks, SpringLaw law, const Particles& p, Forces& f) {
+  const uint32_t nb = blocks.count();
+  if (nb <= 2) {
+    spring_range(s, 0, s.slots.size(), law, p, f);
+    return;
+  }
+  for (uint32_t parity = 0; parity < 2; ++parity) {
+    const uint32_t count = (nb - parity + 1) / 2;
+    parallel_for(0, count, 1, [&](uint32_t begin, uint32_t end, int) {
+      for (uint32_t k = begin; k < end; ++k) {
+        const uint32_t b = 2 * k + parity;
+        spring_range(s, blocks.spring_begin[b], blocks.spring_begin[b + 1], law, p, f);
+      }
+    });
+  }
+}
+
+double spring_energy(const Springs& s, SpringLaw law, const Particles& p) {
+  double energy = 0.0;
+  for (uint32_t e = 0; e < s.slots.size(); ++e) {
+    if (!s.slots.alive(e)) continue;
+    const uint32_t i = s.i[e], j = s.j[e];
+    const double dx = p.x[j] - p.x[i], dy = p.y[j] - p.y[i], dz = p.z[j] - p.z[i];
+    const double ext = std::sqrt(dx * dx + dy * dy + dz * dz) - s.rest_length[e];
+    energy += law == SpringLaw::Linear ? 0.5 * s.stiffness[e] * ext * ext
+                                       : s.stiffness[e] * std::fabs(ext) * ext * ext / 3.0;
+  }
+  return energy;
+}
+
+double max_stiffness_over_mass(const Springs& s, const Particles& p) {
+  std::vector<double> k_sum(p.slots.size(), 0.0);
+  for (uint32_t e = 0; e < s.slots.size(); ++e) {
+    if (!s.slots.alive(e)) continue;
+    k_sum[s.i[e]] += s.stiffness[e];
+    k_sum[s.j[e]] += s.stiffness[e];
+  }
+  double worst = 0.0;
+  for (uint32_t v = 0; v < p.slots.size(); ++v) worst = std::max(worst, k_sum[v] * p.inv_mass[v]);
+  return worst;
+}
+
+}  // namespace phaco::springs

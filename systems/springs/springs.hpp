@@ -1,0 +1,53 @@
+#pragma once
+// Springs of a membrane from its triangles, and the spring-force pass.
+//
+// Stiffness (seed 000 §5.1): k_e = c·(a1 + a2)/l², with a1, a2 the areas of the two triangles
+// sharing edge e (one for a rim edge) and l its length. For an equilateral lattice this network
+// has the 2D Young's modulus of a sheet with c = E·h (E Young's modulus, h thickness): a
+// triangular spring lattice of stiffness k has E_2D = 2k/√3 and (a1 + a2)/l² = √3/2 there. In
+// our units E in kPa = mN/mm², so c = E[kPa]·h[mm] is in mN/mm. Uniform weighting gives every
+// spring that equilateral value, k = c·√3/2.
+//
+// Pre-stretch (seed 000 §5.2): rest length = (1 − prestretch)·mesh length, so the sheet is under
+// tension at rest and a cut opens by itself.
+//
+// Reads: particles (x, y, z), triangles. Writes: springs; forces (accumulated).
+#include <span>
+
+#include "components/particles.hpp"
+#include "components/springs.hpp"
+#include "components/triangles.hpp"
+
+namespace phaco::springs {
+
+struct SpringMaterial {
+  SpringLaw law = SpringLaw::Linear;
+  StiffnessWeighting weighting = StiffnessWeighting::AreaWeighted;
+  double sheet_modulus_mn_mm = 26.0;  // c = E·h: 2000 kPa × 0.013 mm for the capsule
+  double prestretch = 0.0;            // fraction of the mesh length, 0 ≤ prestretch < 1
+  // For the quadratic law, k_quad = k_linear / reference_extension_mm, so both laws give the same
+  // force at that extension.
+  double quadratic_reference_mm = 0.01;
+};
+
+// One spring per edge, sorted by (i, j); stiffness and rest length from the current positions.
+Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& material);
+
+// Partition for the parallel force pass; `target_blocks` is a mesh-size choice (e.g. 64), never
+// the thread count. Falls back to fewer (at worst one) blocks when springs span far in index.
+SpringBlocks plan_blocks(const Springs& springs, uint32_t particle_count, uint32_t target_blocks = 64);
+
+// Adds every spring's force to both ends: f_i += F·x̂, f_j −= F·x̂ with x̂ from i to j and
+// F = k·(l − l0) (linear) or k·(l − l0)·|l − l0| (quadratic). Parallel over even then odd blocks;
+// bit-identical for any thread count.
+void add_spring_forces(const Springs& springs, const SpringBlocks& blocks, SpringLaw law,
+                       const Particles& particles, Forces& forces);
+
+// Elastic energy, mN·mm = µJ (summed in a fixed order).
+double spring_energy(const Springs& springs, SpringLaw law, const Particles& particles);
+
+// Largest k/m over the particles (1/s²), the quantity that bounds an explicit step:
+// ω_max² ≈ Σ_springs k / m at a particle.
+double max_stiffness_over_mass(const Springs& springs, const Particles& particles);
+
+}  // namespace phaco::springs

@@ -1,0 +1,197 @@
+#include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <cmath>
+
+#include "procedures/eye/eye_mesh.hpp"
+#include "systems/springs/springs.hpp"
+
+namespace phaco {
+namespace {
+
+using springs::SpringMaterial;
+
+struct Sheet {
+  Particles particles;
+  Triangles triangles;
+};
+
+Sheet from_mesh(const SurfaceMesh& mesh) {
+  Sheet s;
+  table_append(s.particles, static_cast<uint32_t>(mesh.vertices.size()));
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    s.particles.x[i] = static_cast<float>(mesh.vertices[i].x());
+    s.particles.y[i] = static_cast<float>(mesh.vertices[i].y());
+    s.particles.z[i] = static_cast<float>(mesh.vertices[i].z());
+    s.particles.inv_mass[i] = 1.0f;
+  }
+  table_append(s.triangles, static_cast<uint32_t>(mesh.triangles.size()));
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    s.triangles.a[t] = mesh.triangles[t][0];
+    s.triangles.b[t] = mesh.triangles[t][1];
+    s.triangles.c[t] = mesh.triangles[t][2];
+  }
+  return s;
+}
+
+Sheet capsule(int level) {
+  return from_mesh(eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level),
+                                     eye::CapsuleLayout::Curvilinear));
+}
+
+// Two triangles sharing the diagonal of the unit square: (0,0) (1,0) (1,1) and (0,0) (1,1) (0,1).
+Sheet square() {
+  SurfaceMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return from_mesh(m);
+}
+
+TEST(BuildSprings, OneSpringPerEdgeWithAreaWeights) {
+  Sheet s = square();
+  const Springs sp = springs::build_springs(s.particles, s.triangles, {.sheet_modulus_mn_mm = 2.0});
+  ASSERT_EQ(sp.slots.size(), 5u);
+  for (uint32_t e = 0; e < 5; ++e) {
+    EXPECT_LT(sp.i[e], sp.j[e]);
+    if (e > 0) EXPECT_TRUE(sp.i[e - 1] < sp.i[e] || (sp.i[e - 1] == sp.i[e] && sp.j[e - 1] < sp.j[e]));
+  }
+  // The diagonal (0,2) has both triangles: k = 2·(0.5 + 0.5)/2 = 1; a side has one: k = 2·0.5/1 = 1.
+  for (uint32_t e = 0; e < 5; ++e) {
+    EXPECT_NEAR(sp.stiffness[e], 1.0, 1e-6) << e;
+    EXPECT_NEAR(sp.rest_length[e], (sp.i[e] == 0 && sp.j[e] == 2) ? std::sqrt(2.0) : 1.0, 1e-6);
+  }
+  const Springs uniform = springs::build_springs(
+      s.particles, s.triangles, {.weighting = StiffnessWeighting::Uniform, .sheet_modulus_mn_mm = 2.0});
+  for (uint32_t e = 0; e < 5; ++e) EXPECT_NEAR(uniform.stiffness[e], std::sqrt(3.0), 1e-6);
+}
+
+TEST(BuildSprings, AreaWeightEqualsUniformOnEquilateralTriangles) {
+  SurfaceMesh m;
+  const double h = std::sqrt(3.0) / 2.0;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, h, 0}, {1.5, h, 0}};
+  m.triangles = {{0, 1, 2}, {1, 3, 2}};
+  Sheet s = from_mesh(m);
+  const Springs sp = springs::build_springs(s.particles, s.triangles, {.sheet_modulus_mn_mm = 1.0});
+  for (uint32_t e = 0; e < sp.slots.size(); ++e) {
+    const bool shared = sp.i[e] == 1 && sp.j[e] == 2;
+    EXPECT_NEAR(sp.stiffness[e], shared ? std::sqrt(3.0) / 2.0 : std::sqrt(3.0) / 4.0, 1e-6) << e;
+  }
+}
+
+TEST(BuildSprings, PrestretchShortensRestLengthAndRejectsBadValues) {
+  Sheet s = square();
+  const Springs sp = springs::build_springs(s.particles, s.triangles, {.prestretch = 0.1});
+  EXPECT_NEAR(sp.rest_length[0], 0.9, 1e-6);
+  EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = 1.0}), std::invalid_argument);
+  EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = -0.1}), std::invalid_argument);
+}
+
+TEST(SpringForces, NoForceAtRestAndNewtonsThirdLawUnderLoad) {
+  Sheet s = capsule(1);
+  for (SpringLaw law : {SpringLaw::Linear, SpringLaw::Quadratic}) {
+    const Springs sp = springs::build_springs(s.particles, s.triangles, {.law = law});
+    const SpringBlocks blocks = springs::plan_blocks(sp, s.particles.slots.size());
+    Forces f;
+    f.resize_zero(s.particles.slots.size());
+    springs::add_spring_forces(sp, blocks, law, s.particles, f);
+    for (uint32_t i = 0; i < s.particles.slots.size(); ++i) ASSERT_NEAR(f.fx[i], 0.0f, 1e-6f);
+
+    Particles moved = s.particles;
+    for (uint32_t i = 0; i < moved.slots.size(); ++i) moved.z[i] += 0.01f * std::sin(0.37f * static_cast<float>(i));
+    f.resize_zero(moved.slots.size());
+    springs::add_spring_forces(sp, blocks, law, moved, f);
+    double sx = 0, sy = 0, sz = 0, mag = 0;
+    for (uint32_t i = 0; i < moved.slots.size(); ++i) {
+      sx += f.fx[i], sy += f.fy[i], sz += f.fz[i];
+      mag += std::fabs(f.fz[i]);
+    }
+    EXPECT_GT(mag, 1e-3);
+    EXPECT_NEAR(sx, 0.0, 1e-5 * mag);
+    EXPECT_NEAR(sy, 0.0, 1e-5 * mag);
+    EXPECT_NEAR(sz, 0.0, 1e-5 * mag);
+  }
+}
+
+// The force is minus the gradient of spring_energy: central differences on a few coordinates.
+TEST(SpringForces, ForceIsMinusEnergyGradient) {
+  Sheet s = capsule(0);
+  for (SpringLaw law : {SpringLaw::Linear, SpringLaw::Quadratic}) {
+    const Springs sp = springs::build_springs(s.particles, s.triangles, {.law = law, .prestretch = 0.05});
+    const SpringBlocks blocks = springs::plan_blocks(sp, s.particles.slots.size());
+    Particles p = s.particles;
+    for (uint32_t i = 0; i < p.slots.size(); ++i) p.x[i] += 0.02f * std::cos(1.3f * static_cast<float>(i));
+    Forces f;
+    f.resize_zero(p.slots.size());
+    springs::add_spring_forces(sp, blocks, law, p, f);
+    for (uint32_t v : {5u, 100u, 400u}) {
+      const float h = 1e-3f;
+      const float x0 = p.x[v];
+      p.x[v] = x0 + h;
+      const double e_plus = springs::spring_energy(sp, law, p);
+      p.x[v] = x0 - h;
+      const double e_minus = springs::spring_energy(sp, law, p);
+      p.x[v] = x0;
+      const double grad = (e_plus - e_minus) / (2.0 * h);
+      EXPECT_NEAR(-grad, f.fx[v], 2e-3 * std::max(1.0, std::fabs(grad))) << "vertex " << v;
+    }
+  }
+}
+
+TEST(SpringBlocks, EverySpringStaysInItsBlockOrTheNext) {
+  Sheet s = capsule(3);
+  const Springs sp = springs::build_springs(s.particles, s.triangles, {});
+  const SpringBlocks b = springs::plan_blocks(sp, s.particles.slots.size(), 64);
+  ASSERT_GT(b.count(), 2u) << "the capsule's ring order allows a parallel partition";
+  EXPECT_EQ(b.particle_begin.front(), 0u);
+  EXPECT_EQ(b.particle_begin.back(), s.particles.slots.size());
+  EXPECT_EQ(b.spring_begin.back(), sp.slots.size());
+  for (uint32_t k = 0; k < b.count(); ++k) {
+    const uint32_t end_next = b.particle_begin[std::min<uint32_t>(k + 2, b.count())];
+    for (uint32_t e = b.spring_begin[k]; e < b.spring_begin[k + 1]; ++e) {
+      ASSERT_GE(sp.i[e], b.particle_begin[k]);
+      ASSERT_LT(sp.i[e], b.particle_begin[k + 1]);
+      ASSERT_LT(sp.j[e], end_next) << "spring " << e << " reaches past the next block";
+    }
+  }
+}
+
+TEST(SpringBlocks, RejectsUnsortedSprings) {
+  Sheet s = square();
+  Springs sp = springs::build_springs(s.particles, s.triangles, {});
+  std::swap(sp.i[0], sp.i[4]);
+  EXPECT_THROW(springs::plan_blocks(sp, 4), std::invalid_argument);
+}
+
+std::vector<float> forces_with_threads(int threads, const Sheet& s, const Springs& sp, const SpringBlocks& b) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
+  tbb::task_arena arena(threads);
+  Forces f;
+  f.resize_zero(s.particles.slots.size());
+  arena.execute([&] { springs::add_spring_forces(sp, b, SpringLaw::Linear, s.particles, f); });
+  std::vector<float> all = f.fx;
+  all.insert(all.end(), f.fy.begin(), f.fy.end());
+  all.insert(all.end(), f.fz.begin(), f.fz.end());
+  return all;
+}
+
+TEST(SpringForces, BitIdenticalForOneTwoAndFourThreads) {
+  Sheet s = capsule(3);
+  for (uint32_t i = 0; i < s.particles.slots.size(); ++i) s.particles.z[i] += 0.003f * std::sin(0.1f * i);
+  const Springs sp = springs::build_springs(s.particles, s.triangles, {.prestretch = 0.02});
+  const SpringBlocks b = springs::plan_blocks(sp, s.particles.slots.size(), 64);
+  const auto one = forces_with_threads(1, s, sp, b);
+  EXPECT_EQ(one, forces_with_threads(2, s, sp, b));
+  EXPECT_EQ(one, forces_with_threads(4, s, sp, b));
+}
+
+TEST(Springs, StiffnessOverMassBoundsTheExplicitStep) {
+  Sheet s = square();
+  for (uint32_t i = 0; i < 4; ++i) s.particles.inv_mass[i] = 0.5f;  // 2 kg each
+  const Springs sp = springs::build_springs(s.particles, s.triangles, {.sheet_modulus_mn_mm = 2.0});
+  // Vertices 0 and 2 carry three springs of k = 1: Σk/m = 3 / 2.
+  EXPECT_NEAR(springs::max_stiffness_over_mass(sp, s.particles), 1.5, 1e-9);
+}
+
+}  // namespace
+}  // namespace phaco
