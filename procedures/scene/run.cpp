@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "engine/core/clock.hpp"
+#include "procedures/scene/capsule_physics.hpp"
 
 namespace phaco {
 
@@ -46,6 +47,7 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
   r.mesh_load_s = scene->mesh_load_s;
   r.elements = element_counts(*scene);
   r.state_hash = state_hash(*scene);
+  if (auto capsule = capsule_physics_summary(*scene); !capsule.is_null()) r.physics["capsule"] = capsule;
   r.peak_memory_mb = peak_memory_mb();
   return r;
 }
@@ -72,6 +74,7 @@ nlohmann::json to_json(const RunReport& r) {
   j["elements"] = elements;
   j["metrics"] = r.metrics;
   j["events"] = r.events;
+  j["physics"] = r.physics;
   j["state_hash"] = r.state_hash;
   return j;
 }
@@ -92,6 +95,14 @@ std::string summary_text(const RunReport& r) {
   }
   out += "elements:";
   for (const auto& [k, v] : r.elements) out += " " + k + "=" + std::to_string(v);
+  for (const auto& [body, ph] : r.physics.items()) {
+    out += "\n" + body + ": " + ph.value("integrator", std::string("?")) + ", active set mean " +
+           std::to_string(static_cast<long long>(ph.value("active_particles_mean", 0.0))) + " / max " +
+           std::to_string(ph.value("active_particles_max", 0u)) + " particles, " +
+           std::to_string(ph.value("frames_stepped", 0ull)) + " frames stepped, " +
+           std::to_string(ph.value("divergences", 0ull)) + " divergences, " + std::to_string(ph.value("grasps", 0ull)) +
+           " grasps";
+  }
   std::snprintf(line, sizeof line, "\npeak memory %.1f MiB   metrics %zu   events %zu   state hash %s\n",
                 r.peak_memory_mb, r.metrics.size(), r.events.size(), r.state_hash.c_str());
   out += line;

@@ -30,6 +30,7 @@ struct RunReport {
   std::vector<std::pair<std::string, uint64_t>> elements;
   nlohmann::json metrics = nlohmann::json::object();  // filled by the drills (issue 7)
   nlohmann::json events = nlohmann::json::array();
+  nlohmann::json physics = nlohmann::json::object();  // per deformable body: method, steps, divergences, active set
   std::string state_hash;
 };
 

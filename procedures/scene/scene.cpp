@@ -12,6 +12,7 @@
 #include "engine/io/mesh_obj.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
+#include "procedures/scene/capsule_physics.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
 
 namespace phaco {
@@ -160,6 +161,22 @@ void replace_meshes_from_files(const Scenario& s, eye::EyeMeshes& meshes) {
   }
 }
 
+// Every `methods` key must name a setting of a body this drill's scene has.
+void check_methods(const Scenario& s, const std::vector<BodyPart>& parts) {
+  const bool has_capsule = std::find(parts.begin(), parts.end(), BodyPart::Capsule) != parts.end();
+  for (const auto& [key, value] : s.methods) {
+    if (!is_capsule_method(key)) {
+      throw InputError(s.source + ": methods[\"" + key +
+                       "\"]: unknown method setting; expected one of: capsule.integrator, capsule.spring_law, "
+                       "capsule.stiffness, capsule.pretension, capsule.active_set");
+    }
+    if (!has_capsule) {
+      throw InputError(s.source + ": methods[\"" + key + "\"]: the " + std::string(to_string(s.drill)) +
+                       " scene has no capsule");
+    }
+  }
+}
+
 std::vector<SystemDesc> base_systems(Scene& scene) {
   std::vector<SystemDesc> systems;
   systems.push_back({.name = "move_tools",
@@ -209,6 +226,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   scene->commands = CommandQueues(options.threads);
 
   const auto parts = bodies_for(scenario.drill);
+  check_methods(scenario, parts);
   const bool need_tets = std::find(parts.begin(), parts.end(), BodyPart::Lens) != parts.end();
   const auto layout = scenario.eye.capsule_layout == "isotropic" ? eye::CapsuleLayout::Isotropic
                                                                   : eye::CapsuleLayout::Curvilinear;
@@ -229,6 +247,10 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   }
 
   std::vector<SystemDesc> systems = base_systems(*scene);
+  if (scene->body(BodyPart::Capsule)) {
+    add_capsule_physics(*scene);
+    systems.push_back(capsule_dynamics_system(*scene));
+  }
   if (options.extra_systems) {
     for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));
   }

@@ -35,9 +35,11 @@ struct Membrane {
   const Dynamics& dynamics;
   const Glue* glue = nullptr;
   const Environment* environment = nullptr;
-  std::span<const uint32_t> active = {};          // sorted particle indices; empty = every particle
-  std::span<const uint32_t> active_springs = {};  // springs with an active end, sorted; used when active is set
-  std::span<const PointLoad> loads = {};           // external point loads; non-finite ones are ignored and counted
+  std::span<const uint32_t> active = {};  // sorted particle indices; empty = every particle
+  // Springs with an active end, sorted; used when active is set.
+  std::span<const uint32_t> active_springs = {};
+  // External point loads (tools, tests); non-finite ones are ignored and counted.
+  std::span<const PointLoad> loads = {};
 };
 
 }  // namespace phaco::deform

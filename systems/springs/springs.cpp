@@ -14,7 +14,10 @@ namespace {
 struct EdgeRecord {
   uint32_t i, j;
   double area;  // sum of the areas of the triangles sharing the edge, mm²
+  double cot;   // half the sum of the cotangents of the angles opposite the edge
 };
+
+Vec3 position(const Particles& p, uint32_t v) { return {p.x[v], p.y[v], p.z[v]}; }
 
 double triangle_area(const Particles& p, uint32_t a, uint32_t b, uint32_t c) {
   const Vec3 pa(p.x[a], p.y[a], p.z[a]), pb(p.x[b], p.y[b], p.z[b]), pc(p.x[c], p.y[c], p.z[c]);
@@ -32,8 +35,11 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
     const uint32_t v[3] = {triangles.a[t], triangles.b[t], triangles.c[t]};
     const double area = triangle_area(particles, v[0], v[1], v[2]);
     for (int k = 0; k < 3; ++k) {
-      const uint32_t a = v[k], b = v[(k + 1) % 3];
-      edges.push_back({std::min(a, b), std::max(a, b), area});
+      const uint32_t a = v[k], b = v[(k + 1) % 3], o = v[(k + 2) % 3];
+      const Vec3 u = position(particles, a) - position(particles, o), w = position(particles, b) - position(particles, o);
+      const double cross = u.cross(w).norm();
+      const double half_cot = cross > 0 ? 0.5 * u.dot(w) / cross : 0.0;
+      edges.push_back({std::min(a, b), std::max(a, b), area, half_cot});
     }
   }
   std::sort(edges.begin(), edges.end(),
@@ -42,9 +48,12 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
   Springs s;
   const double equilateral = std::sqrt(3.0) / 2.0;
   for (size_t e = 0; e < edges.size();) {
-    double area = 0.0;
+    double area = 0.0, cot = 0.0;
     size_t f = e;
-    for (; f < edges.size() && edges[f].i == edges[e].i && edges[f].j == edges[e].j; ++f) area += edges[f].area;
+    for (; f < edges.size() && edges[f].i == edges[e].i && edges[f].j == edges[e].j; ++f) {
+      area += edges[f].area;
+      cot += edges[f].cot;
+    }
     const uint32_t a = edges[e].i, b = edges[e].j;
     const double dx = particles.x[b] - particles.x[a], dy = particles.y[b] - particles.y[a],
                  dz = particles.z[b] - particles.z[a];
@@ -52,10 +61,22 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
     double k = m.sheet_modulus_mn_mm *
                (m.weighting == StiffnessWeighting::AreaWeighted && l > 0 ? area / (l * l) : equilateral);
     if (m.law == SpringLaw::Quadratic) k /= m.quadratic_reference_mm;
+    double rest = (1.0 - m.prestretch) * l;
+    if (m.pretension == Pretension::Cotangent && k > 0) {
+      const double tension = 1.5 * m.prestretch * m.sheet_modulus_mn_mm * cot * l;  // mN
+      const double extension = m.law == SpringLaw::Linear
+                                   ? tension / k
+                                   : std::copysign(std::sqrt(std::fabs(tension) / k), tension);
+      rest = l - extension;
+      if (rest < 0.5 * l) {
+        throw std::invalid_argument("cotangent pre-tension needs a rest length below half of edge (" +
+                                    std::to_string(a) + ", " + std::to_string(b) + "): mesh too badly shaped");
+      }
+    }
     const uint32_t idx = table_add(s);
     s.i[idx] = a;
     s.j[idx] = b;
-    s.rest_length[idx] = static_cast<float>((1.0 - m.prestretch) * l);
+    s.rest_length[idx] = static_cast<float>(rest);
     s.stiffness[idx] = static_cast<float>(k);
     e = f;
   }

@@ -8,8 +8,16 @@
 // our units E in kPa = mN/mm², so c = E[kPa]·h[mm] is in mN/mm. Uniform weighting gives every
 // spring that equilateral value, k = c·√3/2.
 //
-// Pre-stretch (seed 000 §5.2): rest length = (1 − prestretch)·mesh length, so the sheet is under
-// tension at rest and a cut opens by itself.
+// Pre-stretch (seed 000 §5.2) puts the sheet under tension at rest, so a cut opens by itself. Two
+// ways to choose the rest lengths:
+//  - UniformPrestretch: rest = (1 − prestretch)·mesh length, as the seed says. On a mesh that is
+//    not equilateral the resulting tension is not isotropic: on the capsule's rings and spokes the
+//    hoop tension is 12 % above the radial one, and the analytic membrane test misses by 17.7 %
+//    (docs/membrane_accuracy.md).
+//  - Cotangent: rest lengths chosen so that spring e carries the tension t_e = T0·(cot α + cot β)/2·l_e
+//    (α, β the angles opposite e): the discrete form of an isotropic membrane stress T0·I, in
+//    equilibrium as built on any triangulation. T0 = 1.5·prestretch·c, the equibiaxial tension of
+//    a sheet of modulus c and Poisson ratio 1/3 (the triangular lattice's) stretched by prestretch.
 //
 // Reads: particles (x, y, z), triangles. Writes: springs; forces (accumulated).
 #include <span>
@@ -20,6 +28,8 @@
 
 namespace phaco::springs {
 
+enum class Pretension : uint8_t { UniformPrestretch, Cotangent };
+
 struct SpringMaterial {
   SpringLaw law = SpringLaw::Linear;
   StiffnessWeighting weighting = StiffnessWeighting::AreaWeighted;
@@ -28,9 +38,12 @@ struct SpringMaterial {
   // For the quadratic law, k_quad = k_linear / reference_extension_mm, so both laws give the same
   // force at that extension.
   double quadratic_reference_mm = 0.01;
+  Pretension pretension = Pretension::UniformPrestretch;
 };
 
 // One spring per edge, sorted by (i, j); stiffness and rest length from the current positions.
+// Throws std::invalid_argument for a prestretch outside [0, 1) or a cotangent tension that would
+// need a rest length below half the edge (an obtuse, badly shaped mesh).
 Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& material);
 
 // Partition for the parallel force pass; `target_blocks` is a mesh-size choice (e.g. 64), never

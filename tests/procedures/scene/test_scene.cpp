@@ -7,6 +7,7 @@
 #include "engine/core/error.hpp"
 #include "engine/core/rng.hpp"
 #include "engine/schedule/parallel.hpp"
+#include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/run.hpp"
 
 namespace phaco {
@@ -167,6 +168,68 @@ TEST(Scene, BadOverrideNamesScenarioAndKey) {
   }
 }
 
+// The forceps close over the capsule, lift the grasped point 0.3 mm and move it sideways: the
+// capsule follows locally, the active set stays a small part of the mesh, nothing diverges.
+Scenario grasp_scenario(const std::string& integrator) {
+  const std::string text = R"({
+    "drill": "capsulorhexis", "eye": { "level": 1 }, "dt_s": 0.008333333333333333, "seed": 3, "duration_s": 1.0,
+    "methods": { "capsule.integrator": ")" + integrator + R"(" },
+    "hands": { "left": { "tool": "forceps", "track": [
+      { "t": 0.0, "pos": [1.0, 0.0, 1.72], "grip": 0.0 },
+      { "t": 0.1, "pos": [1.0, 0.0, 1.72], "grip": 1.0 },
+      { "t": 0.6, "pos": [1.2, 0.3, 2.02], "grip": 1.0 },
+      { "t": 1.0, "pos": [1.2, 0.3, 2.02], "grip": 1.0 } ] } } })";
+  return parse_scenario(text, "grasp.json", ".");
+}
+
+TEST(CapsulePhysics, GraspLiftsTheCapsuleLocally) {
+  for (const std::string integrator : {"implicit_euler", "implicit_predictor", "semi_implicit_001"}) {
+    SCOPED_TRACE(integrator);
+    SceneOptions o;
+    o.cache_dir = cache_dir();
+    auto scene = build_scene(grasp_scenario(integrator), o);
+    const Entity capsule = *scene->body(BodyPart::Capsule);
+    const Particles before = scene->world.at<Particles>(capsule);
+    for (uint64_t f = 0; f < scene->scenario.frame_count(); ++f) step(*scene);
+    const Particles& p = scene->world.at<Particles>(capsule);
+    const CapsulePhysics& cp = scene->world.at<CapsulePhysics>(capsule);
+    EXPECT_EQ(cp.grasps, 1u);
+    const ToolGrasp& g = scene->world.at<ToolGrasp>(scene->tools[0]);
+    ASSERT_TRUE(g.capsule.holding());
+    EXPECT_NEAR(p.z[g.capsule.particle], 2.02f, 1e-5f) << "the held point is at the forceps tip";
+    uint32_t lifted_neighbours = 0;
+    for (uint32_t i = 0; i < p.slots.size(); ++i) {
+      ASSERT_TRUE(std::isfinite(p.x[i]) && std::isfinite(p.y[i]) && std::isfinite(p.z[i]));
+      const float dz = p.z[i] - before.z[i];
+      const float r = std::hypot(before.x[i] - 1.0f, before.y[i]);
+      if (r > 0.05f && r < 0.3f && dz > 0.02f) ++lifted_neighbours;
+    }
+    EXPECT_GT(lifted_neighbours, 3u) << "the membrane around the grasp rises with it";
+    EXPECT_GT(cp.active_particle_max, 20u);
+    EXPECT_LT(cp.active_particle_max, p.slots.size() / 2) << "cost stays local: the active set is a small part";
+    EXPECT_EQ(cp.state.status.fallbacks, 0u);
+  }
+}
+
+TEST(CapsulePhysics, BadMethodsAreRejectedByName) {
+  SceneOptions o;
+  o.cache_dir = cache_dir();
+  Scenario s = grasp_scenario("runge_kutta");
+  try {
+    build_scene(s, o);
+    FAIL() << "unknown integrator accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("grasp.json: methods[\"capsule.integrator\"]: unknown choice 'runge_kutta'"),
+              std::string::npos) << e.what();
+  }
+  s = grasp_scenario("xpbd");
+  s.methods["lens.integrator"] = "xpbd";
+  EXPECT_THROW(build_scene(s, o), InputError);
+  s = grasp_scenario("xpbd");
+  s.drill = Drill::CornealIncision;
+  EXPECT_THROW(build_scene(s, o), InputError) << "the incision scene has no capsule";
+}
+
 TEST(Run, ReportHasEveryRequiredField) {
   SceneOptions o;
   o.cache_dir = cache_dir();
@@ -187,6 +250,7 @@ TEST(Run, ReportHasEveryRequiredField) {
   EXPECT_GT(j["elements"]["capsule.particles"].get<uint64_t>(), 500u);
   EXPECT_GT(j["peak_memory_mb"].get<double>(), 1.0);
   EXPECT_EQ(j["state_hash"].get<std::string>().size(), 16u);
+  EXPECT_EQ(j["physics"]["capsule"]["integrator"], "implicit_euler");
 }
 
 }  // namespace

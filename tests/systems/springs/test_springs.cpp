@@ -87,6 +87,58 @@ TEST(BuildSprings, PrestretchShortensRestLengthAndRejectsBadValues) {
   EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = -0.1}), std::invalid_argument);
 }
 
+// A flat grid of right triangles with alternating diagonals (the rings-and-spokes pattern, unrolled)
+// and a jitter: not equilateral anywhere.
+Sheet jittered_grid(int n) {
+  SurfaceMesh m;
+  for (int r = 0; r <= n; ++r) {
+    for (int c = 0; c <= n; ++c) {
+      const double jx = 0.15 * std::sin(1.7 * r + 2.3 * c), jy = 0.15 * std::cos(2.9 * r - 1.1 * c);
+      m.vertices.push_back({c + jx, 1.3 * r + jy, 0.0});
+    }
+  }
+  auto id = [n](int r, int c) { return static_cast<uint32_t>(r * (n + 1) + c); };
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) {
+      if ((r + c) % 2 == 0) {
+        m.triangles.push_back({id(r, c), id(r, c + 1), id(r + 1, c + 1)});
+        m.triangles.push_back({id(r, c), id(r + 1, c + 1), id(r + 1, c)});
+      } else {
+        m.triangles.push_back({id(r, c), id(r, c + 1), id(r + 1, c)});
+        m.triangles.push_back({id(r, c + 1), id(r + 1, c + 1), id(r + 1, c)});
+      }
+    }
+  }
+  return from_mesh(m);
+}
+
+// Cotangent pre-tension is the discrete isotropic stress: interior vertices are in equilibrium as
+// built. A uniform pre-stretch on the same mesh leaves them unbalanced.
+TEST(Pretension, CotangentBalancesInteriorVerticesUniformDoesNot) {
+  const int n = 12;
+  Sheet s = jittered_grid(n);
+  auto max_interior_force = [&](springs::Pretension mode, SpringLaw law) {
+    const Springs sp = springs::build_springs(
+        s.particles, s.triangles, {.law = law, .sheet_modulus_mn_mm = 26.0, .prestretch = 0.03, .pretension = mode});
+    Forces f;
+    f.resize_zero(s.particles.slots.size());
+    springs::add_spring_forces(sp, springs::plan_blocks(sp, s.particles.slots.size()), law, s.particles, f);
+    double worst = 0.0;
+    for (int r = 1; r < n; ++r) {
+      for (int c = 1; c < n; ++c) {
+        const uint32_t v = static_cast<uint32_t>(r * (n + 1) + c);
+        worst = std::max(worst, static_cast<double>(std::hypot(f.fx[v], f.fy[v])));
+      }
+    }
+    return worst;
+  };
+  // The tension scale: T0·l ≈ 1.5·0.03·26 mN/mm × 1 mm ≈ 1.2 mN.
+  for (SpringLaw law : {SpringLaw::Linear, SpringLaw::Quadratic}) {
+    EXPECT_LT(max_interior_force(springs::Pretension::Cotangent, law), 1e-4);
+    EXPECT_GT(max_interior_force(springs::Pretension::UniformPrestretch, law), 0.05);
+  }
+}
+
 TEST(SpringForces, NoForceAtRestAndNewtonsThirdLawUnderLoad) {
   Sheet s = capsule(1);
   for (SpringLaw law : {SpringLaw::Linear, SpringLaw::Quadratic}) {

@@ -1,0 +1,184 @@
+#pragma once
+// Implicit integrators of a membrane: backward Euler solved by conjugate gradients, and seed
+// 004's approximate implicit predictor. Both stay stable at the frame step (1/120 s) with the
+// capsule's real material, where an explicit step would need dt of a few microseconds.
+//
+// Implicit Euler (Baraff & Witkin 1998, one Newton step of backward Euler):
+//
+//   (M − dt·∂f/∂v − dt²·∂f/∂x)·Δv = dt·(f(x, v) + dt·∂f/∂x·v),   v⁺ = v + Δv,  x⁺ = x + dt·v⁺
+//
+// f: springs (linear or quadratic law), gravity m·g, damping and viscosity −m·(γ + κ)·v, glue
+// −g·(x − x_glue). ∂f/∂x from 3×3 spring blocks (spring_force_jacobian below); ∂f/∂v = −m·(γ+κ)·I.
+// Unknowns are the free particles of the active set (all free particles when the set is empty);
+// anchored, scripted and sleeping particles are fixed during the step (a scripted particle was
+// already put at its end-of-frame position by the tool, DESIGN.md §4 step 1), so they bring no
+// velocity term into the right side. Cost follows the active set: only its springs and unknowns are
+// touched (plus O(active) bookkeeping).
+//
+// One linearised step is not enough on its own at the capsule's k·dt²/m ≈ 10⁷: it is then a full
+// Newton step of the static problem, and where springs rotate or buckle it overshoots and pumps
+// energy in (measured: level 1 blew up after 16 frames). So the step is a Newton step on the
+// incremental potential of backward Euler (Gast et al. 2015),
+//   Φ(x) = Σ m/(2dt²)·|x − x_n − dt·v_n|² + Σ m·(γ+κ)/(2dt)·|x − x_n|² + U_springs(x)
+//          + Σ g/2·|x − x_glue|² − Σ m·g·x,
+// whose minimiser is the backward-Euler state and whose Newton direction from x_n is exactly
+// Δx = dt·(v_n + Δv) above; the step x⁺ = x_n + α·Δx, v⁺ = α·Δx/dt takes the largest α in
+// {1, ½, ¼, ...} with Φ(x⁺) ≤ Φ(x_n). With α = 1 (the usual case) it is Baraff–Witkin's step.
+//
+// The system is solved with Eigen::ConjugateGradient (Jacobi preconditioner), relative tolerance
+// settings.cg_tolerance (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each
+// particle. Two operators: an assembled row-major sparse matrix whose pattern is built once per
+// unknown set and whose values are refilled every step, or a matrix-free operator over the stored
+// spring and diagonal blocks (the default: it streams ~3× fewer bytes per product and measured
+// 2.2–3.4× faster per step at levels 0–5, docs/implicit_and_active.md). Eigen's CG allocates its
+// four work vectors once per solve; nothing else in a steady-state step allocates.
+//
+// Approximate implicit predictor (seed 004 "pre computes the solution to a linear system [9]",
+// [9] = Desbrun, Schröder & Barr 1999): the system matrix is frozen and factorised once
+// (SimplicialLDLT), A = M·(1 + dt·(γ+κ)) + dt²·(H + g·I), and every step filters the exact
+// nonlinear force through it:
+//
+//   Δv = A⁻¹·dt·(f(x, v) − dt·(H + g·I)·v),   then the same line search as implicit Euler
+//
+// which is Desbrun's v⁺ = v + W·dt·M⁻¹·f, W = (I + dt²·M⁻¹·H)⁻¹, plus backward Euler's velocity
+// term. Two frozen stiffnesses H (settings.predictor_stiffness):
+//   Isotropic       Desbrun's choice: k_e·I per spring, the same for x, y and z, so one scalar n×n
+//                   factorisation serves all three axes. It dominates the true stiffness
+//                   (k·I ≥ k·d̂d̂ᵀ + k·(1 − l0/l)·(I − d̂d̂ᵀ) while l < 2·l0), hence stable, but a
+//                   membrane's out-of-plane stiffness comes only from its tension (≈ prestretch·k),
+//                   so the filter slows out-of-plane motion by about 1/prestretch.
+//   FrozenJacobian  the spring blocks of implicit Euler at the configuration of the
+//                   precomputation (3n×3n): for small displacements it is implicit Euler.
+// The factorisation is recomputed when dt, masses, particle kinds (a grasp turns a free particle
+// into a scripted one), damping, glue, the law or the spring count change, and on invalidate()
+// (call it after a cut or a tear, or to re-freeze H at the current shape). Desbrun's rotational
+// post-correction is not applied: our membranes are held at their rim, so there is no free rigid
+// rotation for the frozen filter to damp. The predictor's unknowns are all free particles (the
+// factorisation is per body); with an active set only the set's particles are moved.
+//
+// Reads: particles (x, v, inv_mass, kind), springs, dynamics, glue, active set.
+// Writes: particles (x, v of the unknowns), forces (of the unknowns: the force at the start of the
+// step), cache.
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <array>
+#include <span>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "systems/deform/membrane.hpp"
+
+namespace phaco::deform {
+
+enum class CgOperator : uint8_t { Assembled, MatrixFree };
+enum class PredictorStiffness : uint8_t { Isotropic, FrozenJacobian };
+
+struct ImplicitSettings {
+  double cg_tolerance = 1.0e-6;  // relative residual
+  int cg_max_iterations = 1000;
+  bool warm_start = true;
+  CgOperator cg_operator = CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
+  // Backtracking on the incremental potential: halve the Newton step at most this many times.
+  int max_line_search_halvings = 12;
+  PredictorStiffness predictor_stiffness = PredictorStiffness::FrozenJacobian;
+  // Quadratic springs have no stiffness at rest; the predictor freezes them at the extension
+  // max(|l − l0|, this) (the default equals SpringMaterial::quadratic_reference_mm).
+  double predictor_quadratic_extension_mm = 0.01;
+};
+
+struct ImplicitStats {
+  uint64_t steps = 0;              // implicit Euler steps
+  int cg_iterations = 0;           // last step
+  double cg_residual = 0.0;        // last step, ‖r‖/‖b‖
+  bool cg_converged = true;        // last step reached the tolerance
+  double step_fraction = 1.0;      // last step: line-search fraction α of the Newton step taken
+  uint64_t line_search_cuts = 0;   // steps that took α < 1
+  uint64_t cg_iterations_total = 0;
+  uint32_t unknowns = 0;           // particles solved for, last step
+  uint32_t springs = 0;            // springs assembled, last step
+  uint64_t nonzeros = 0;           // scalar entries of the operator (stored or applied), last step
+  uint64_t pattern_builds = 0;     // implicit Euler: unknown set or springs changed
+  uint64_t predictor_steps = 0;
+  uint64_t precomputations = 0;    // predictor factorisations
+  uint32_t predictor_unknowns = 0;
+};
+
+// Symmetric 3×3 block as (xx, xy, xz, yy, yz, zz).
+using Sym3 = std::array<double, 6>;
+
+struct SpringForceJacobian {
+  std::array<double, 3> force_on_i{};  // mN; force on j is the opposite
+  Sym3 k{};                            // mN/mm; ∂f_i/∂x_j = k, ∂f_i/∂x_i = −k
+};
+
+// One spring from i to j (d = x_j − x_i): force on i and its Jacobian block. Linear F = k·(l − l0),
+// quadratic F = k·(l − l0)·|l − l0|; block = F'(l)·d̂d̂ᵀ + max(F/l, 0)·(I − d̂d̂ᵀ). The transverse
+// term F/l is negative under compression; it is clamped to zero so the block, and with it the
+// system matrix, stays positive semidefinite (the buckling direction gets no negative stiffness).
+SpringForceJacobian spring_force_jacobian(double dx, double dy, double dz, double rest_length, double stiffness,
+                                          SpringLaw law);
+
+// Scratch and state carried between steps of one body. Sized on first use (and when the particle
+// count or the unknown set changes); steady-state steps reuse it.
+struct ImplicitCache {
+  ImplicitSettings settings;
+  ImplicitStats stats;
+
+  // Call after a cut or tear (topology), or a material change: rebuilds pattern and factorisation.
+  void invalidate() { pattern_valid = false, predictor_valid = false; }
+
+  // --- implicit Euler ---
+  bool pattern_valid = false;
+  CgOperator pattern_operator = CgOperator::MatrixFree;  // the operator the pattern was built for
+  std::vector<double> warm_dv;             // 3 per particle: the last Δv, the CG's first guess
+  std::vector<uint32_t> unknown_of;        // per particle: unknown index, or kNotUnknown
+  std::vector<uint32_t> unknowns;          // particle of each unknown, sorted
+  std::vector<uint32_t> step_springs;      // springs with an unknown end, sorted
+  std::vector<uint32_t> candidate_unknowns, candidate_springs;
+  std::vector<uint32_t> spring_ui, spring_uj;      // unknown index of each end, or kNotUnknown
+  std::vector<uint32_t> spring_pos_ij, spring_pos_ji;  // block position of j in i's row and back
+  std::vector<uint32_t> block_begin, block_col;    // block CSR over unknowns (self included)
+  std::vector<uint32_t> diag_pos;                  // block position of the diagonal in each row
+  std::vector<Sym3> spring_k;                      // per step spring: Jacobian block
+  std::vector<Sym3> diag_block;                    // per unknown: diagonal block of the system
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> matrix;
+  Eigen::VectorXd force, rhs, dv, guess, inverse_diagonal, step_dx;
+
+  // --- predictor ---
+  bool predictor_valid = false;
+  uint64_t predictor_key = 0;                 // hash of what the factorisation depends on
+  std::vector<uint32_t> predictor_unknown_of;  // per particle
+  std::vector<uint32_t> predictor_unknowns;
+  std::vector<uint32_t> predictor_springs;     // springs with an unknown end
+  std::vector<Sym3> predictor_k;               // per predictor spring: frozen block (k·I when isotropic)
+  // Behind a pointer so the cache (and every body's state holding it) stays movable: Eigen's
+  // factorisations are neither copyable nor movable.
+  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> predictor_factor =
+      std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
+  Eigen::VectorXd predictor_force, predictor_rhs, predictor_dv;  // 3 per unknown
+};
+
+constexpr uint32_t kNotUnknown = 0xffffffffu;
+
+namespace implicit_detail {
+// Mass scaling as the other deform integrators read it: a non-positive scale counts as 1.
+inline double mass_scale(const Dynamics& d) { return d.mass_scale > 0.0f ? double(d.mass_scale) : 1.0; }
+
+// The largest α in {1, ½, ¼, ...} (at most settings.max_line_search_halvings cuts) with
+// Φ(x_n + α·Δx) ≤ Φ(x_n), Φ the incremental potential above. unknown_of maps a particle to its
+// unknown u (Δx at step_dx[3u..3u+2]) or kNotUnknown; `springs` are those with an unknown end.
+double line_search(const Membrane& m, double dt, int max_halvings, std::span<const uint32_t> unknowns,
+                   std::span<const uint32_t> unknown_of, std::span<const uint32_t> springs, const double* step_dx);
+// Adds the membrane's point loads on unknowns to a force vector laid out 3 per unknown (mN).
+void add_point_loads(const Membrane& m, std::span<const uint32_t> unknown_of, double* force);
+}  // namespace implicit_detail
+
+// One backward-Euler step of the membrane (see the top of this file).
+void implicit_euler_step(Membrane& m, double dt_s, ImplicitCache& cache);
+
+// One step of the seed-004 approximate implicit predictor (see the top of this file).
+void implicit_predictor_step(Membrane& m, double dt_s, ImplicitCache& cache);
+
+}  // namespace phaco::deform

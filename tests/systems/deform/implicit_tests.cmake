@@ -1,0 +1,8 @@
+# Implicit Euler and the seed-004 predictor (systems/deform/implicit*.cpp); included from this
+# folder's CMakeLists.txt.
+phaco_test(test_implicit
+  SOURCES
+    ${CMAKE_CURRENT_LIST_DIR}/test_implicit.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_implicit_active.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_implicit_predictor.cpp
+  LIBS phaco_sys_deform phaco_sys_springs phaco_sys_active_nodes phaco_eye TBB::tbb)
