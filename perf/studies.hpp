@@ -1,0 +1,24 @@
+#pragma once
+// The studies phaco-perf runs. Each measures, writes perf/results/<study>.csv/.json, its charts
+// perf/results/<study>_*.png and its markdown section perf/results/<study>.md, then RESULTS.md is
+// reassembled from every section present (perf/report.hpp).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace phaco::perf {
+
+struct StudyOptions {
+  bool quick = false;                 // small levels, few steps: about a minute, for CI
+  std::filesystem::path out_dir;      // holds RESULTS.md and results/
+  std::vector<std::string> extra;     // study-specific options left after the common ones
+};
+
+void run_foundation(const StudyOptions& options);
+void run_bandwidth(const StudyOptions& options);
+void run_membrane(const StudyOptions& options);
+
+// Rewrites out_dir/RESULTS.md from the machine description and the sections in out_dir/results.
+void regenerate_results(const std::filesystem::path& out_dir);
+
+}  // namespace phaco::perf
