@@ -42,6 +42,18 @@ struct SpringBlocks {
   uint32_t count() const { return particle_begin.empty() ? 0 : static_cast<uint32_t>(particle_begin.size() - 1); }
 };
 
+// CSR adjacency of the spring graph, built once per topology (systems/springs: build_spring_graph;
+// rebuild after a cut or tear). Neighbours of particle p: neighbour[offset[p] .. offset[p+1]),
+// sorted by particle index; spring[k] is the spring joining p to neighbour[k]. The active node
+// set and force propagation walk it breadth-first.
+struct SpringGraph {
+  std::vector<uint32_t> offset;     // particle_count + 1
+  std::vector<uint32_t> neighbour;  // 2 × live springs
+  std::vector<uint32_t> spring;     // 2 × live springs
+
+  uint32_t particle_count() const { return offset.empty() ? 0 : static_cast<uint32_t>(offset.size() - 1); }
+};
+
 // Per-particle force accumulator, mN; scratch rebuilt every step.
 struct Forces {
   std::vector<float> fx, fy, fz;

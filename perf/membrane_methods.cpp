@@ -176,7 +176,7 @@ ActiveSample measure_active_grasp(MembraneFixture& f, int threads, double min_se
   }
   f.forces.resize_zero(f.vertex_count());
   const double force_threshold = std::max(1.0e-2, 2.0 * residual);
-  const active_nodes::SpringGraph graph = active_nodes::build_spring_graph(f.springs, f.vertex_count());
+  const SpringGraph graph = springs::build_spring_graph(f.springs, f.vertex_count());
   active_nodes::ActiveSet set;
   Dynamics dyn;
   dyn.law = f.options.law;
@@ -332,7 +332,7 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
 
   // Force propagation, quasi-static: one propagation per frame.
   {
-    const force_propagation::PropagationGraph graph = force_propagation::build_graph(f.springs, f.vertex_count());
+    const SpringGraph graph = springs::build_spring_graph(f.springs, f.vertex_count());
     force_propagation::PropagationScratch scratch;
     const uint32_t sources[1] = {f.centre};
     const float fz[1] = {static_cast<float>(-kLoadMn)}, zero[1] = {0.0f};

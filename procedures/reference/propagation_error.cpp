@@ -31,7 +31,7 @@ PropagationStudy propagation_error_study(const PropagationCase& c) {
   }
 
   // The grasp: centre vertex and its neighbours, scripted.
-  const force_propagation::PropagationGraph graph = force_propagation::build_graph(springs, n);
+  const SpringGraph graph = springs::build_spring_graph(springs, n);
   std::vector<uint32_t> grasp = {0};
   for (uint32_t r = graph.offset[0]; r < graph.offset[1]; ++r) grasp.push_back(graph.neighbour[r]);
   study.grasped = static_cast<uint32_t>(grasp.size());

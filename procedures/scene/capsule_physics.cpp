@@ -80,7 +80,7 @@ void add_capsule_physics(Scene& scene) {
   cp.blocks = springs::plan_blocks(cp.springs, particles.slots.size());
   cp.forces.resize_zero(particles.slots.size());
   cp.glue = Glue{particles.x, particles.y, particles.z};
-  cp.graph = active_nodes::build_spring_graph(cp.springs, particles.slots.size());
+  cp.graph = springs::build_spring_graph(cp.springs, particles.slots.size());
 
   cp.environment.has_lens = true;
   cp.environment.lens_radius_mm = 0.5 * params.get("lens.equatorial_diameter_mm");

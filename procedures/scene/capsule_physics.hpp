@@ -34,7 +34,7 @@ struct CapsulePhysics {
   Glue glue;
   deform::Environment environment;
   deform::DeformState state;
-  active_nodes::SpringGraph graph;
+  SpringGraph graph;
   active_nodes::ActiveSet active;
   bool use_active_set = true;
   uint32_t active_hops = 8;

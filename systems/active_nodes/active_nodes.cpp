@@ -7,42 +7,6 @@
 
 namespace phaco::active_nodes {
 
-SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count) {
-  SpringGraph g;
-  g.offset.assign(static_cast<size_t>(particle_count) + 1, 0);
-  const uint32_t ns = springs.slots.size();
-  for (uint32_t e = 0; e < ns; ++e) {
-    if (!springs.slots.alive(e)) continue;
-    if (springs.i[e] >= particle_count || springs.j[e] >= particle_count)
-      throw std::invalid_argument("build_spring_graph: spring " + std::to_string(e) + " names a particle beyond " +
-                                  std::to_string(particle_count));
-    ++g.offset[springs.i[e] + 1];
-    ++g.offset[springs.j[e] + 1];
-  }
-  for (uint32_t p = 0; p < particle_count; ++p) g.offset[p + 1] += g.offset[p];
-  g.neighbour.resize(g.offset.back());
-  g.spring.resize(g.offset.back());
-  std::vector<uint32_t> fill(g.offset.begin(), g.offset.end() - 1);
-  for (uint32_t e = 0; e < ns; ++e) {
-    if (!springs.slots.alive(e)) continue;
-    const uint32_t a = springs.i[e], b = springs.j[e];
-    g.neighbour[fill[a]] = b, g.spring[fill[a]++] = e;
-    g.neighbour[fill[b]] = a, g.spring[fill[b]++] = e;
-  }
-  // Sort each row by neighbour so the graph does not depend on the spring table's order.
-  std::vector<std::pair<uint32_t, uint32_t>> row;
-  for (uint32_t p = 0; p < particle_count; ++p) {
-    row.clear();
-    for (uint32_t k = g.offset[p]; k < g.offset[p + 1]; ++k) row.emplace_back(g.neighbour[k], g.spring[k]);
-    std::sort(row.begin(), row.end());
-    for (uint32_t k = g.offset[p]; k < g.offset[p + 1]; ++k) {
-      g.neighbour[k] = row[k - g.offset[p]].first;
-      g.spring[k] = row[k - g.offset[p]].second;
-    }
-  }
-  return g;
-}
-
 namespace {
 
 double speed_sq(const Particles& p, uint32_t i) {

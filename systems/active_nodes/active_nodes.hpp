@@ -32,20 +32,7 @@
 
 namespace phaco::active_nodes {
 
-// CSR adjacency of the spring graph, built once per topology (rebuild after a cut or tear).
-// Neighbours of particle p: neighbour[offset[p] .. offset[p+1]), sorted by particle index;
-// spring[k] is the spring joining p to neighbour[k].
-struct SpringGraph {
-  std::vector<uint32_t> offset;     // particle_count + 1
-  std::vector<uint32_t> neighbour;  // 2 × springs
-  std::vector<uint32_t> spring;     // 2 × springs
-
-  uint32_t particle_count() const { return offset.empty() ? 0 : static_cast<uint32_t>(offset.size() - 1); }
-};
-
-// Every alive spring contributes both directions. Throws std::invalid_argument if a spring names
-// a particle ≥ particle_count.
-SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count);
+// The spring graph (components/springs.hpp) comes from springs::build_spring_graph.
 
 struct WakeInputs {
   // Positions and velocities after the last step; null: no wake rules (only the seeds' ball).

@@ -7,31 +7,6 @@
 
 namespace phaco::force_propagation {
 
-PropagationGraph build_graph(const Springs& springs, uint32_t particle_count) {
-  PropagationGraph g;
-  g.offset.assign(particle_count + 1, 0);
-  const uint32_t m = springs.slots.size();
-  for (uint32_t e = 0; e < m; ++e) {
-    if (!springs.slots.alive(e)) continue;
-    ++g.offset[springs.i[e] + 1];
-    ++g.offset[springs.j[e] + 1];
-  }
-  for (uint32_t p = 0; p < particle_count; ++p) g.offset[p + 1] += g.offset[p];
-  g.neighbour.resize(g.offset.back());
-  g.spring.resize(g.offset.back());
-  std::vector<uint32_t> fill(g.offset.begin(), g.offset.end() - 1);
-  // Springs are visited in index order, so each row lists its springs in increasing index; with
-  // springs sorted by (i, j) that is increasing neighbour within the j > p part and within the
-  // j < p part. The row order only has to be fixed, not sorted, for determinism.
-  for (uint32_t e = 0; e < m; ++e) {
-    if (!springs.slots.alive(e)) continue;
-    const uint32_t a = springs.i[e], b = springs.j[e];
-    g.neighbour[fill[a]] = b, g.spring[fill[a]++] = e;
-    g.neighbour[fill[b]] = a, g.spring[fill[b]++] = e;
-  }
-  return g;
-}
-
 namespace {
 
 struct NodeState {
@@ -40,7 +15,7 @@ struct NodeState {
 };
 
 // Net spring force on node i and its stiffness block, from the current positions.
-NodeState node_state(const Particles& p, const Springs& s, SpringLaw law, const PropagationGraph& g,
+NodeState node_state(const Particles& p, const Springs& s, SpringLaw law, const SpringGraph& g,
                      uint32_t i) {
   NodeState st{Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()};
   const Eigen::Vector3d xi(p.x[i], p.y[i], p.z[i]);
@@ -65,7 +40,7 @@ NodeState node_state(const Particles& p, const Springs& s, SpringLaw law, const 
 }
 
 // One local Newton step at node i; returns the length of the move, mm.
-double relax_node(Particles& p, const Springs& s, SpringLaw law, const PropagationGraph& g,
+double relax_node(Particles& p, const Springs& s, SpringLaw law, const SpringGraph& g,
                   uint32_t i, const Eigen::Vector3d& external, double omega) {
   NodeState st = node_state(p, s, law, g, i);
   st.force += external;
@@ -81,7 +56,7 @@ double relax_node(Particles& p, const Springs& s, SpringLaw law, const Propagati
 }
 
 // Appends layer `layer` (neighbours of layer − 1 not seen yet); false when it is empty.
-bool expand_layer(const PropagationGraph& g, PropagationScratch& sc, int layer) {
+bool expand_layer(const SpringGraph& g, PropagationScratch& sc, int layer) {
   const uint32_t from = sc.layer_begin[layer - 1], to = sc.layer_begin[layer];
   for (uint32_t o = from; o < to; ++o) {
     const uint32_t v = sc.order[o];
@@ -99,7 +74,7 @@ bool expand_layer(const PropagationGraph& g, PropagationScratch& sc, int layer) 
 }  // namespace
 
 PropagationResult propagate(Particles& particles, const Springs& springs, SpringLaw law,
-                            const PropagationGraph& graph, std::span<const uint32_t> sources,
+                            const SpringGraph& graph, std::span<const uint32_t> sources,
                             const PropagationSettings& settings, PropagationScratch& sc,
                             const SourceForces* forces) {
   PropagationResult result;

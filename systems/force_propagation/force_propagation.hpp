@@ -39,20 +39,7 @@
 
 namespace phaco::force_propagation {
 
-// Spring adjacency in compressed rows: the neighbours of particle p are
-// neighbour[offset[p] .. offset[p+1]) in increasing index, reached by spring[...]. Built once per
-// topology change.
-struct PropagationGraph {
-  std::vector<uint32_t> offset;     // particles + 1
-  std::vector<uint32_t> neighbour;  // 2 × live springs
-  std::vector<uint32_t> spring;     // 2 × live springs
-
-  uint32_t particle_count() const {
-    return offset.empty() ? 0 : static_cast<uint32_t>(offset.size() - 1);
-  }
-};
-
-PropagationGraph build_graph(const Springs& springs, uint32_t particle_count);
+// The spring graph (components/springs.hpp) comes from springs::build_spring_graph.
 
 struct PropagationSettings {
   int max_layers = 16;         // layers relaxed beyond the sources (topological distance)
@@ -90,7 +77,7 @@ struct PropagationScratch {
 // (or under `forces`). Sources are particle indices (duplicates ignored). Anchored and scripted
 // particles are never moved; they pass the propagation on.
 PropagationResult propagate(Particles& particles, const Springs& springs, SpringLaw law,
-                            const PropagationGraph& graph, std::span<const uint32_t> sources,
+                            const SpringGraph& graph, std::span<const uint32_t> sources,
                             const PropagationSettings& settings, PropagationScratch& scratch,
                             const SourceForces* forces = nullptr);
 

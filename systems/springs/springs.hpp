@@ -46,6 +46,10 @@ struct SpringMaterial {
 // need a rest length below half the edge (an obtuse, badly shaped mesh).
 Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& material);
 
+// Both directions of every alive spring, rows sorted by neighbour (independent of the spring
+// table's order). Throws std::invalid_argument if a spring names a particle ≥ particle_count.
+SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count);
+
 // Partition for the parallel force pass; `target_blocks` is a mesh-size choice (e.g. 64), never
 // the thread count. Falls back to fewer (at worst one) blocks when springs span far in index.
 SpringBlocks plan_blocks(const Springs& springs, uint32_t particle_count, uint32_t target_blocks = 64);

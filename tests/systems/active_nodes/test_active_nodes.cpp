@@ -14,7 +14,6 @@ namespace phaco {
 namespace {
 
 using active_nodes::ActiveSet;
-using active_nodes::SpringGraph;
 using active_nodes::WakeInputs;
 
 struct Grid {
@@ -46,7 +45,7 @@ Grid make_grid(int n, bool king) {
       if (king && r + 1 < n && c + 1 < n) link(g.at(r, c), g.at(r + 1, c + 1));
       if (king && r + 1 < n && c > 0) link(g.at(r, c), g.at(r + 1, c - 1));
     }
-  g.graph = active_nodes::build_spring_graph(g.springs, g.particles.slots.size());
+  g.graph = springs::build_spring_graph(g.springs, g.particles.slots.size());
   return g;
 }
 
@@ -183,7 +182,7 @@ TEST(ActiveNodes, FiveHopsOnTheCapsuleMatchSeed003) {
   for (size_t i = 0; i < mesh.triangles.size(); ++i)
     t.a[i] = mesh.triangles[i][0], t.b[i] = mesh.triangles[i][1], t.c[i] = mesh.triangles[i][2];
   const Springs s = springs::build_springs(p, t, {});
-  const SpringGraph g = active_nodes::build_spring_graph(s, p.slots.size());
+  const SpringGraph g = springs::build_spring_graph(s, p.slots.size());
   // Seeds at half the radius on four sides and the centre.
   double radius = 0.0;
   for (const Vec3& v : mesh.vertices) radius = std::max(radius, std::hypot(v.x(), v.y()));

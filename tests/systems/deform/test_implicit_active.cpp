@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "systems/springs/springs.hpp"
 #include "systems/active_nodes/active_nodes.hpp"
 #include "tests/systems/deform/implicit_fixtures.hpp"
 
@@ -25,7 +26,7 @@ void grasp_centre(Body& b, int n, uint32_t hops) {
   const uint32_t g = centre(n);
   b.particles.kind[g] = ParticleKind::Scripted;
   b.particles.vz[g] = 10.0f;
-  const auto graph = active_nodes::build_spring_graph(b.springs, b.particles.slots.size());
+  const auto graph = springs::build_spring_graph(b.springs, b.particles.slots.size());
   active_nodes::ActiveSet set;
   const uint32_t seeds[] = {g};
   active_nodes::update_active_set(graph, seeds, hops, {}, set);

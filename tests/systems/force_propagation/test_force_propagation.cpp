@@ -19,7 +19,7 @@ struct Sheet {
   Particles particles;
   Triangles triangles;
   Springs springs;
-  PropagationGraph graph;
+  SpringGraph graph;
   uint32_t n = 0;
   uint32_t at(uint32_t i, uint32_t j) const { return j * n + i; }
 };
@@ -54,7 +54,7 @@ Sheet make_sheet(uint32_t n, double h = 0.1, double prestretch = 0.05) {
       s.particles, s.triangles,
       springs::SpringMaterial{SpringLaw::Linear, StiffnessWeighting::AreaWeighted, 26.0,
                               prestretch});
-  s.graph = build_graph(s.springs, n * n);
+  s.graph = springs::build_spring_graph(s.springs, n * n);
   return s;
 }
 
