@@ -9,6 +9,7 @@
 #include "engine/core/error.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/springs/springs.hpp"
+#include "systems/topology_check/topology_check.hpp"
 
 namespace phaco {
 
@@ -105,6 +106,16 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
           .run = [&scene, capsule](const FrameContext& ctx) {
             Particles& p = scene.world.at<Particles>(capsule);
             CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
+            if constexpr (topology_check::kCheckEveryFrame) {
+              // Debug builds check the membrane's structural invariants every frame (issue 4 item 4):
+              // edges, orientation, springs = edges, indices, no NaN. The area and angle bounds are
+              // zero here: a pulled membrane legitimately squeezes triangles (0.24° seen in the
+              // demo); those bounds judge the mesh a cut produces, not the deformed shape.
+              static const topology_check::InvariantThresholds kStructuralOnly{0.0, 0.0};
+              const auto report = topology_check::check_membrane(p, scene.world.at<Triangles>(capsule), cp.springs,
+                                                                 kStructuralOnly);
+              if (!report.ok()) throw std::logic_error("capsule invariants broken: " + report.summary());
+            }
 
             // Seeds of the active set: what the forceps hold this frame.
             std::array<uint32_t, 2> seeds{};
