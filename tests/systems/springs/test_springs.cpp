@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "tests/support/membrane_tables.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/springs/springs.hpp"
 
@@ -19,19 +20,8 @@ struct Sheet {
 
 Sheet from_mesh(const SurfaceMesh& mesh) {
   Sheet s;
-  table_append(s.particles, static_cast<uint32_t>(mesh.vertices.size()));
-  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-    s.particles.x[i] = static_cast<float>(mesh.vertices[i].x());
-    s.particles.y[i] = static_cast<float>(mesh.vertices[i].y());
-    s.particles.z[i] = static_cast<float>(mesh.vertices[i].z());
-    s.particles.inv_mass[i] = 1.0f;
-  }
-  table_append(s.triangles, static_cast<uint32_t>(mesh.triangles.size()));
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    s.triangles.a[t] = mesh.triangles[t][0];
-    s.triangles.b[t] = mesh.triangles[t][1];
-    s.triangles.c[t] = mesh.triangles[t][2];
-  }
+  s.particles = test::particles_from(mesh);
+  s.triangles = test::triangles_from(mesh);
   return s;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/membrane_tables.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/springs/springs.hpp"
 #include "systems/topology_check/topology_check.hpp"
@@ -29,19 +30,8 @@ struct Membrane {
 
 Membrane from_mesh(const SurfaceMesh& mesh) {
   Membrane m;
-  table_append(m.particles, static_cast<uint32_t>(mesh.vertices.size()));
-  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-    m.particles.x[i] = static_cast<float>(mesh.vertices[i].x());
-    m.particles.y[i] = static_cast<float>(mesh.vertices[i].y());
-    m.particles.z[i] = static_cast<float>(mesh.vertices[i].z());
-    m.particles.inv_mass[i] = 1.0f;
-  }
-  table_append(m.triangles, static_cast<uint32_t>(mesh.triangles.size()));
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    m.triangles.a[t] = mesh.triangles[t][0];
-    m.triangles.b[t] = mesh.triangles[t][1];
-    m.triangles.c[t] = mesh.triangles[t][2];
-  }
+  m.particles = test::particles_from(mesh);
+  m.triangles = test::triangles_from(mesh);
   m.springs = springs::build_springs(m.particles, m.triangles, {});
   return m;
 }
