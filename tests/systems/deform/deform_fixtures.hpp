@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "tests/support/particle_checks.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/deform/deform.hpp"
 #include "systems/springs/springs.hpp"
@@ -143,23 +144,9 @@ inline uint32_t centre_particle(const Body& b) {
   return best;
 }
 
-inline bool all_finite(const Particles& p) {
-  for (uint32_t i = 0; i < p.slots.size(); ++i)
-    for (float v : {p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i]})
-      if (!std::isfinite(v)) return false;
-  return true;
-}
+using test::all_finite;
+using test::hash_state;
 
-inline uint64_t hash_state(const Particles& p) {
-  uint64_t h = 1469598103934665603ull;
-  for (const std::vector<float>* col : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz})
-    for (float v : *col) {
-      uint32_t bits;
-      std::memcpy(&bits, &v, 4);
-      h = (h ^ bits) * 1099511628211ull;
-    }
-  return h;
-}
 
 inline double max_speed(const Particles& p) {
   double s = 0.0;

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "tests/support/particle_checks.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/deform/implicit.hpp"
 #include "systems/springs/springs.hpp"
@@ -126,23 +127,8 @@ inline double total_energy(const Body& b) {
   return e;
 }
 
-inline bool all_finite(const Particles& p) {
-  for (uint32_t i = 0; i < p.slots.size(); ++i)
-    if (!std::isfinite(p.x[i]) || !std::isfinite(p.y[i]) || !std::isfinite(p.z[i]) || !std::isfinite(p.vx[i]) ||
-        !std::isfinite(p.vy[i]) || !std::isfinite(p.vz[i]))
-      return false;
-  return true;
-}
+using test::all_finite;
+using test::hash_state;
 
-inline uint64_t hash_state(const Particles& p) {
-  uint64_t h = 1469598103934665603ull;
-  for (const std::vector<float>* col : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz})
-    for (float v : *col) {
-      uint32_t bits;
-      std::memcpy(&bits, &v, 4);
-      h = (h ^ bits) * 1099511628211ull;
-    }
-  return h;
-}
 
 }  // namespace phaco::implicit_test
