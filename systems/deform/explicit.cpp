@@ -112,10 +112,15 @@ void sum_axial_stiffness(const Membrane& m, std::vector<float>& kappa) {
   for (const uint32_t e : m.active_springs) add_axial(m, e, kappa);
 }
 
-Motion explicit_euler_step(Membrane& m, double dt_s) {
+namespace {
+
+// Explicit and symplectic Euler differ only in whether the velocity is updated before the
+// position moves with it; one loop serves both, over the whole body or the active set.
+template <bool kSymplectic>
+Motion euler_step(Membrane& m, double dt_s) {
   const uint32_t rejected = compute_forces(m);
   if (m.active.empty()) {
-    Motion motion = explicit_whole_body<false>(m, static_cast<float>(dt_s));
+    Motion motion = explicit_whole_body<kSymplectic>(m, static_cast<float>(dt_s));
     motion.rejected_loads = rejected;
     return motion;
   }
@@ -125,37 +130,21 @@ Motion explicit_euler_step(Membrane& m, double dt_s) {
               inv_scale = inverse_mass_scale(m.dynamics);
   Motion motion = for_each_in_play(particles_in_play(m), [&](uint32_t i, ChunkMotion& local) {
     const float w = integrating_inv_mass(p, i, inv_scale);
-    const float h =
-        w > 0.0f ? dt : 0.0f;  // scripted particles keep their imposed velocity and stay put
-    p.x[i] += h * p.vx[i], p.y[i] += h * p.vy[i], p.z[i] += h * p.vz[i];
+    const float h = w > 0.0f ? dt : 0.0f;  // scripted particles keep their imposed velocity and stay put
+    if constexpr (!kSymplectic) p.x[i] += h * p.vx[i], p.y[i] += h * p.vy[i], p.z[i] += h * p.vz[i];
     p.vx[i] += dt * w * f.fx[i], p.vy[i] += dt * w * f.fy[i], p.vz[i] += dt * w * f.fz[i];
+    if constexpr (kSymplectic) p.x[i] += h * p.vx[i], p.y[i] += h * p.vy[i], p.z[i] += h * p.vz[i];
     observe(local, w > 0.0f, p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], limit2);
   });
   motion.rejected_loads = rejected;
   return motion;
 }
 
-Motion symplectic_euler_step(Membrane& m, double dt_s) {
-  const uint32_t rejected = compute_forces(m);
-  if (m.active.empty()) {
-    Motion motion = explicit_whole_body<true>(m, static_cast<float>(dt_s));
-    motion.rejected_loads = rejected;
-    return motion;
-  }
-  Particles& p = m.particles;
-  const Forces& f = m.forces;
-  const float dt = static_cast<float>(dt_s), limit2 = speed_limit2(m),
-              inv_scale = inverse_mass_scale(m.dynamics);
-  Motion motion = for_each_in_play(particles_in_play(m), [&](uint32_t i, ChunkMotion& local) {
-    const float w = integrating_inv_mass(p, i, inv_scale);
-    const float h = w > 0.0f ? dt : 0.0f;
-    p.vx[i] += dt * w * f.fx[i], p.vy[i] += dt * w * f.fy[i], p.vz[i] += dt * w * f.fz[i];
-    p.x[i] += h * p.vx[i], p.y[i] += h * p.vy[i], p.z[i] += h * p.vz[i];
-    observe(local, w > 0.0f, p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], limit2);
-  });
-  motion.rejected_loads = rejected;
-  return motion;
-}
+}  // namespace
+
+Motion explicit_euler_step(Membrane& m, double dt_s) { return euler_step<false>(m, dt_s); }
+
+Motion symplectic_euler_step(Membrane& m, double dt_s) { return euler_step<true>(m, dt_s); }
 
 Motion semi_implicit_001_step(Membrane& m, double dt_s, std::vector<float>& kappa) {
   const uint32_t rejected = compute_forces(m);
