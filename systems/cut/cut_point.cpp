@@ -64,11 +64,6 @@ Closest closest_on(const Particles& p, const Triangles& tr, uint32_t t, const Ve
                              particle_position(p, tr.c[t]));
 }
 
-int slot_of(const Triangles& tr, uint32_t t, uint32_t vertex) {
-  for (int k = 0; k < 3; ++k)
-    if (corner(tr, t, k) == vertex) return k;
-  return -1;
-}
 
 uint32_t scan_nearest(const Particles& p, const Triangles& tr, const Vec3& point) {
   uint32_t best = kInvalidIndex;
@@ -169,7 +164,7 @@ void vertex_fan(const Triangles& tr, const TriangleAdjacency& adj, uint32_t tria
   for (int dir = 0; dir < 2; ++dir) {
     uint32_t cur = triangle;
     for (uint32_t guard = 0; guard < adj.neighbour.size(); ++guard) {
-      const int k = slot_of(tr, cur, vertex);
+      const int k = corner_slot(tr, cur, vertex);
       const int edge = dir == 0 ? k : (k + 2) % 3;  // edge (k, k+1) or (k-1, k)
       const uint32_t n = adj.neighbour[cur][edge];
       if (n == kInvalidIndex || n == triangle) break;
@@ -217,7 +212,7 @@ CutPoint locate_cut_point(const Particles& p, const Triangles& tr, const Triangl
     r.a = v;
     r.position = particle_position(p, v);
     r.bary = Vec3::Zero();
-    r.bary[slot_of(tr, r.triangle, v)] = 1.0;
+    r.bary[corner_slot(tr, r.triangle, v)] = 1.0;
     r.distance_mm = (point - r.position).norm();
     return r;
   }
@@ -248,8 +243,8 @@ CutPoint locate_cut_point(const Particles& p, const Triangles& tr, const Triangl
     r.t = s;
     r.position = (1.0 - s) * particle_position(p, a) + s * particle_position(p, b);
     r.bary = Vec3::Zero();
-    r.bary[slot_of(tr, r.triangle, a)] = 1.0 - s;
-    r.bary[slot_of(tr, r.triangle, b)] = s;
+    r.bary[corner_slot(tr, r.triangle, a)] = 1.0 - s;
+    r.bary[corner_slot(tr, r.triangle, b)] = s;
     r.distance_mm = (point - r.position).norm();
     return r;
   }
@@ -260,6 +255,32 @@ CutPoint locate_cut_point(const Particles& p, const Triangles& tr, const Triangl
   r.position = c.position;
   r.distance_mm = c.distance;
   return r;
+}
+
+bool projected_bary(const Particles& p, const Triangles& tr, uint32_t T, const Vec3& q, Vec3& w) {
+  const Vec3 A = particle_position(p, tr.a[T]);
+  const Vec3 v0 = particle_position(p, tr.b[T]) - A, v1 = particle_position(p, tr.c[T]) - A;
+  const Vec3 v2 = q - A;
+  const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1);
+  const double d20 = v2.dot(v0), d21 = v2.dot(v1);
+  const double denom = d00 * d11 - d01 * d01;
+  if (!(denom > 1e-300)) return false;
+  const double v = (d11 * d20 - d01 * d21) / denom, u = (d00 * d21 - d01 * d20) / denom;
+  w = Vec3(1.0 - v - u, v, u);
+  return true;
+}
+
+double exit_parameter(const Vec3& from, const Vec3& target, int& exit) {
+  constexpr double kDirTol = 1e-12;  // barycentric rate treated as zero (moving along an edge)
+  const Vec3 d = target - from;
+  double s = std::numeric_limits<double>::infinity();
+  exit = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] >= -kDirTol) continue;
+    const double si = std::max(from[i], 0.0) / -d[i];
+    if (si < s) s = si, exit = i;
+  }
+  return s;
 }
 
 }  // namespace phaco::cut

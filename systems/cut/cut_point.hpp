@@ -74,4 +74,20 @@ inline uint32_t corner(const Triangles& tr, uint32_t t, int k) {
   return k == 0 ? tr.a[t] : (k == 1 ? tr.b[t] : tr.c[t]);
 }
 
+// Barycentric weights (of corners a, b, c) of q projected on the plane of triangle T; false if T
+// is degenerate.
+bool projected_bary(const Particles& p, const Triangles& tr, uint32_t T, const Vec3& q, Vec3& w);
+
+// Walking in barycentric weights from `from` straight toward `target`: how far (in units of the
+// whole way) the line stays inside the triangle, infinity if the target is inside; `exit` is the
+// corner whose weight reaches 0 first (the line leaves across the edge opposite it), -1 if none.
+double exit_parameter(const Vec3& from, const Vec3& target, int& exit);
+
+// Which corner (0, 1, 2) of triangle t is particle v; -1 if none.
+inline int corner_slot(const Triangles& tr, uint32_t t, uint32_t v) {
+  for (int k = 0; k < 3; ++k)
+    if (corner(tr, t, k) == v) return k;
+  return -1;
+}
+
 }  // namespace phaco::cut

@@ -10,7 +10,6 @@ namespace phaco::cut {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kDirTol = 1e-12;    // barycentric rate treated as zero (moving along an edge)
 constexpr double kEndTol = 1e-12;    // exit parameter this close to 1 = the target itself
 constexpr double kStuckTol = 1e-12;  // exit parameter this close to 0 = no way forward
 
@@ -24,51 +23,18 @@ struct Location {
   Vec3 position = Vec3::Zero();
 };
 
-int slot_of(const Triangles& tr, uint32_t t, uint32_t v) {
-  for (int k = 0; k < 3; ++k)
-    if (corner(tr, t, k) == v) return k;
-  return -1;
-}
 
 // Barycentric weights of the location in triangle T (which holds it).
 Vec3 bary_in(const Triangles& tr, const Location& l, uint32_t T) {
   Vec3 w = Vec3::Zero();
   if (l.kind == CutPoint::Face) return l.bary;
   if (l.kind == CutPoint::Vertex) {
-    w[slot_of(tr, T, l.a)] = 1.0;
+    w[corner_slot(tr, T, l.a)] = 1.0;
   } else {
-    w[slot_of(tr, T, l.a)] = 1.0 - l.t;
-    w[slot_of(tr, T, l.b)] = l.t;
+    w[corner_slot(tr, T, l.a)] = 1.0 - l.t;
+    w[corner_slot(tr, T, l.b)] = l.t;
   }
   return w;
-}
-
-// Barycentric weights of q projected on the plane of T; false if T is degenerate.
-bool projected_bary(const Particles& p, const Triangles& tr, uint32_t T, const Vec3& q, Vec3& w) {
-  const Vec3 A = particle_position(p, tr.a[T]);
-  const Vec3 v0 = particle_position(p, tr.b[T]) - A, v1 = particle_position(p, tr.c[T]) - A;
-  const Vec3 v2 = q - A;
-  const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1);
-  const double d20 = v2.dot(v0), d21 = v2.dot(v1);
-  const double denom = d00 * d11 - d01 * d01;
-  if (!(denom > 1e-300)) return false;
-  const double v = (d11 * d20 - d01 * d21) / denom, u = (d00 * d21 - d01 * d20) / denom;
-  w = Vec3(1.0 - v - u, v, u);
-  return true;
-}
-
-// How far (in units of the way to the projected target) the straight line from `from` towards
-// `target` stays inside T; kInf when the target is inside; `exit` the corner whose weight hits 0.
-double exit_parameter(const Vec3& from, const Vec3& target, int& exit) {
-  const Vec3 d = target - from;
-  double s = kInf;
-  exit = -1;
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] >= -kDirTol) continue;
-    const double si = std::max(from[i], 0.0) / -d[i];
-    if (si < s) s = si, exit = i;
-  }
-  return s;
 }
 
 double chord_parameter(const Vec3& x, const CutPoint& from, const CutPoint& to) {

@@ -26,6 +26,29 @@ double triangle_area(const Particles& p, uint32_t a, uint32_t b, uint32_t c) {
 
 }  // namespace
 
+SpringConstants edge_spring_constants(const SpringMaterial& m, double l, double area_sum, double half_cot_sum) {
+  static const double equilateral = std::sqrt(3.0) / 2.0;
+  SpringConstants out;
+  double k = m.sheet_modulus_mn_mm *
+             (m.weighting == StiffnessWeighting::AreaWeighted && l > 0 ? area_sum / (l * l) : equilateral);
+  if (m.law == SpringLaw::Quadratic) k /= m.quadratic_reference_mm;
+  double rest = (1.0 - m.prestretch) * l;
+  if (m.pretension == Pretension::Cotangent && k > 0) {
+    const double tension = 1.5 * m.prestretch * m.sheet_modulus_mn_mm * half_cot_sum * l;  // mN
+    const double extension = m.law == SpringLaw::Linear
+                                 ? tension / k
+                                 : std::copysign(std::sqrt(std::fabs(tension) / k), tension);
+    if (l - extension < 0.5 * l) {
+      out.pretension_clamped = true;  // fall back to the uniform pre-stretch for this edge
+    } else {
+      rest = l - extension;
+    }
+  }
+  out.stiffness = k;
+  out.rest_length = rest;
+  return out;
+}
+
 Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& m) {
   if (!(m.prestretch >= 0.0 && m.prestretch < 1.0)) throw std::invalid_argument("prestretch must be in [0, 1)");
   std::vector<EdgeRecord> edges;
@@ -46,7 +69,6 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
             [](const EdgeRecord& x, const EdgeRecord& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
 
   Springs s;
-  const double equilateral = std::sqrt(3.0) / 2.0;
   for (size_t e = 0; e < edges.size();) {
     double area = 0.0, cot = 0.0;
     size_t f = e;
@@ -58,21 +80,12 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
     const double dx = particles.x[b] - particles.x[a], dy = particles.y[b] - particles.y[a],
                  dz = particles.z[b] - particles.z[a];
     const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
-    double k = m.sheet_modulus_mn_mm *
-               (m.weighting == StiffnessWeighting::AreaWeighted && l > 0 ? area / (l * l) : equilateral);
-    if (m.law == SpringLaw::Quadratic) k /= m.quadratic_reference_mm;
-    double rest = (1.0 - m.prestretch) * l;
-    if (m.pretension == Pretension::Cotangent && k > 0) {
-      const double tension = 1.5 * m.prestretch * m.sheet_modulus_mn_mm * cot * l;  // mN
-      const double extension = m.law == SpringLaw::Linear
-                                   ? tension / k
-                                   : std::copysign(std::sqrt(std::fabs(tension) / k), tension);
-      rest = l - extension;
-      if (rest < 0.5 * l) {
-        throw std::invalid_argument("cotangent pre-tension needs a rest length below half of edge (" +
-                                    std::to_string(a) + ", " + std::to_string(b) + "): mesh too badly shaped");
-      }
+    const SpringConstants sc = edge_spring_constants(m, l, area, cot);
+    if (sc.pretension_clamped) {
+      throw std::invalid_argument("cotangent pre-tension needs a rest length below half of edge (" +
+                                  std::to_string(a) + ", " + std::to_string(b) + "): mesh too badly shaped");
     }
+    const double k = sc.stiffness, rest = sc.rest_length;
     const uint32_t idx = table_add(s);
     s.i[idx] = a;
     s.j[idx] = b;

@@ -41,6 +41,21 @@ struct SpringMaterial {
   Pretension pretension = Pretension::UniformPrestretch;
 };
 
+// Stiffness and rest length of the spring on an edge of length `length` (mm) in the shape the
+// springs are built from, whose
+// one or two triangles have areas summing to area_sum and half the sum of the cotangents of the
+// angles opposite the edge half_cot_sum. A cotangent rest length below half the edge (a sliver)
+// is not used: the uniform pre-stretch is, and pretension_clamped says so. build_springs and the
+// cut's local re-springing (systems/cut) share it, so a cut region gets the springs a fresh build
+// would give it.
+struct SpringConstants {
+  double stiffness = 0.0;
+  double rest_length = 0.0;
+  bool pretension_clamped = false;
+};
+SpringConstants edge_spring_constants(const SpringMaterial& material, double length, double area_sum,
+                                      double half_cot_sum);
+
 // One spring per edge, sorted by (i, j); stiffness and rest length from the current positions.
 // Throws std::invalid_argument for a prestretch outside [0, 1) or a cotangent tension that would
 // need a rest length below half the edge (an obtuse, badly shaped mesh).

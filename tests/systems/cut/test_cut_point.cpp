@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "tests/support/grid_mesh.hpp"
 #include "tests/support/membrane_tables.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/cut/cut_point.hpp"
@@ -28,30 +29,8 @@ Sheet from_mesh(const SurfaceMesh& mesh) {
   return s;
 }
 
-// n x n vertices at unit spacing in z = 0, jittered by up to `jitter` (deterministic), quads
-// split along alternating diagonals. Vertex (i, j) is j*n + i.
-Sheet grid(int n, double jitter) {
-  SurfaceMesh m;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const bool rim = i == 0 || j == 0 || i == n - 1 || j == n - 1;
-      const double jx = rim ? 0.0 : jitter * std::sin(12.9898 * i + 78.233 * j);
-      const double jy = rim ? 0.0 : jitter * std::sin(39.3468 * i + 11.135 * j + 1.0);
-      m.vertices.emplace_back(i + jx, j + jy, 0.0);
-    }
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i) {
-      const uint32_t v00 = j * n + i, v10 = v00 + 1, v01 = v00 + n, v11 = v01 + 1;
-      if ((i + j) % 2 == 0) {
-        m.triangles.push_back({v00, v10, v11});
-        m.triangles.push_back({v00, v11, v01});
-      } else {
-        m.triangles.push_back({v00, v10, v01});
-        m.triangles.push_back({v10, v11, v01});
-      }
-    }
-  return from_mesh(m);
-}
+// The unit grid of tests/support/grid_mesh.hpp.
+Sheet grid(int n, double jitter) { return from_mesh(test::grid_mesh(n, jitter)); }
 
 Vec3 pos(const Sheet& s, uint32_t v) {
   return particle_position(s.particles, v);
