@@ -1,0 +1,169 @@
+#include "systems/tear/tear.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace phaco::tear {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Vec3 radial(const Vec3& p) {
+  const Vec3 r(p.x(), p.y(), 0.0);
+  const double n = r.norm();
+  return n > 1e-12 ? Vec3(r / n) : Vec3::Zero();
+}
+
+// Is (u, v) an edge whose two triangles are still joined (so the tear can run along it)?
+bool joined(const cut::CutMesh& m, uint32_t u, uint32_t v) {
+  std::vector<uint32_t> tris;
+  cut::triangles_on_edge(m, u, v, tris);
+  if (tris.size() != 2) return false;
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t a = cut::corner(m.triangles, tris[0], k), b = cut::corner(m.triangles, tris[0], (k + 1) % 3);
+    if ((a == u && b == v) || (a == v && b == u)) return m.topology.adjacency.neighbour[tris[0]][k] == tris[1];
+  }
+  return false;
+}
+
+}  // namespace
+
+std::string_view to_string(TearRule r) { return r == TearRule::FlapForce ? "flap_force" : "most_stressed_spring"; }
+
+std::string_view to_string(TearEvent::Kind k) {
+  switch (k) {
+    case TearEvent::RunoutWarning: return "runout_warning";
+    case TearEvent::RadialTearout: return "radial_tearout";
+    default: return "completed";
+  }
+}
+
+uint32_t TearState::count(TearEvent::Kind k) const {
+  return static_cast<uint32_t>(std::count_if(events.begin(), events.end(), [k](const TearEvent& e) { return e.kind == k; }));
+}
+
+RunoutCheck check_runout(const Vec3& tip, const Vec3& direction, const TearSettings& s) {
+  RunoutCheck c;
+  const Vec3 p(tip.x(), tip.y(), 0.0);
+  Vec3 d(direction.x(), direction.y(), 0.0);
+  if (d.norm() < 1e-12) return c;
+  d.normalize();
+  const Vec3 r = radial(tip);
+  c.outward_angle_deg = std::asin(std::clamp(d.dot(r), -1.0, 1.0)) * 180.0 / kPi;
+  const double R = s.safe_radius_mm, pd = p.dot(d), pp = p.squaredNorm();
+  if (pp >= R * R) {
+    c.distance_to_safe_edge_mm = 0.0;
+  } else {
+    c.distance_to_safe_edge_mm = -pd + std::sqrt(pd * pd - (pp - R * R));  // |p + s·d| = R, s > 0
+  }
+  c.warn = c.outward_angle_deg > s.warn_angle_deg || c.distance_to_safe_edge_mm < s.warn_lookahead_mm;
+  return c;
+}
+
+Vec3 vertex_normal(const cut::CutMesh& m, uint32_t v) {
+  std::vector<uint32_t> fan;
+  cut::vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[v], v, fan);
+  Vec3 n = Vec3::Zero();
+  for (uint32_t t : fan) {
+    const Vec3 a = cut::particle_position(m.particles, m.triangles.a[t]);
+    n += (cut::particle_position(m.particles, m.triangles.b[t]) - a)
+             .cross(cut::particle_position(m.particles, m.triangles.c[t]) - a);
+  }
+  return n.norm() > 0 ? Vec3(n.normalized()) : Vec3(0, 0, 1);
+}
+
+Vec3 flap_force_step(const Vec3& tip, const Vec3& normal, const Vec3& c_hat, const Vec3& flap_force,
+                     const TearSettings& s) {
+  const Vec3 f = flap_force - flap_force.dot(normal) * normal;
+  if (f.norm() < s.threshold_mn) return Vec3::Zero();
+  Vec3 c = c_hat - c_hat.dot(normal) * normal;
+  if (c.norm() > 0) c.normalize();
+  Vec3 step = s.a_mm_per_mn * f + s.b_mm * c;
+  if (s.outward_bias != 0.0) {
+    Vec3 r = radial(tip);
+    r -= r.dot(normal) * normal;
+    step += s.outward_bias * s.a_mm_per_mn * f.norm() * r;
+  }
+  const double len = step.norm();
+  if (len > s.max_step_mm) step *= s.max_step_mm / len;
+  return step;
+}
+
+uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const TearSettings& s) {
+  std::vector<uint32_t> fan;
+  cut::vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[tip], tip, fan);
+  uint32_t best = kInvalidIndex;
+  double best_force = -1.0;
+  for (uint32_t t : fan) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t n = cut::corner(m.triangles, t, k);
+      if (n == tip || !joined(m, tip, n)) continue;
+      const auto it = m.topology.spring_of_edge.find(cut::edge_key(tip, n));
+      if (it == m.topology.spring_of_edge.end()) continue;
+      const double rest = m.springs.rest_length[it->second];
+      const double len = (cut::particle_position(m.particles, n) - cut::particle_position(m.particles, tip)).norm();
+      if (rest <= 0 || (len - rest) / rest <= s.break_strain) continue;
+      const double force = m.springs.stiffness[it->second] * (len - rest);
+      if (force > best_force || (force == best_force && n < best)) best_force = force, best = n;
+    }
+  }
+  return best;
+}
+
+TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, const Vec3& flap_force,
+                         const TearSettings& tear, const cut::CutSettings& cut, cut::EditLog& log) {
+  if (path.tip == kInvalidIndex || !m.particles.slots.alive(path.tip))
+    throw std::invalid_argument("tear_step: the path has no tip (puncture and cut a flap first)");
+  if (!flap_force.allFinite()) throw std::invalid_argument("tear_step: the flap force is not finite");
+  TearStepReport r;
+  if (state.complete || path.reached_boundary) return r;
+  ++state.steps;
+  const uint32_t tip = path.tip;
+  const Vec3 x = cut::particle_position(m.particles, tip);
+  Vec3 target;
+  if (tear.rule == TearRule::FlapForce) {
+    const Vec3 step = flap_force_step(x, vertex_normal(m, tip), path.direction, flap_force, tear);
+    if (step.norm() == 0.0) return r;
+    // The tear front runs ahead of the tip while snapping keeps the tip waiting for a good split.
+    if (!state.front_valid) state.front = x, state.front_valid = true;
+    state.front += step;
+    target = state.front;
+  } else {
+    const uint32_t n = most_stressed_spring_end(m, tip, tear);
+    if (n == kInvalidIndex) return r;
+    target = cut::particle_position(m.particles, n);
+  }
+  const RunoutCheck check = check_runout(x, target - x, tear);
+  if (check.warn && state.warning_armed) {
+    state.events.push_back({TearEvent::RunoutWarning, state.steps, std::hypot(x.x(), x.y()), check.outward_angle_deg, x});
+    state.warning_armed = false;
+    r.warned = true;
+  } else if (!check.warn) {
+    state.warning_armed = true;
+  }
+  r.segment = cut::cut_towards(m, path, target, cut, log);
+  if (r.segment.made) {
+    r.advanced = true;
+    ++state.advances;
+    const Vec3 now = cut::particle_position(m.particles, path.tip);
+    if ((now - state.front).norm() <= cut.snap.vertex_snap_mm || tear.rule != TearRule::FlapForce) state.front = now;
+    const double radius = std::hypot(now.x(), now.y());
+    state.max_radius_mm = std::max(state.max_radius_mm, radius);
+    if (radius > tear.safe_radius_mm && !state.torn_out) {
+      state.torn_out = true;
+      r.torn_out = true;
+      state.events.push_back({TearEvent::RadialTearout, state.steps, radius, check.outward_angle_deg, now});
+    }
+  }
+  if (r.segment.reached_boundary) {
+    state.complete = true;
+    r.completed = true;
+    const Vec3 now = cut::particle_position(m.particles, path.tip);
+    state.events.push_back({TearEvent::Completed, state.steps, std::hypot(now.x(), now.y()), check.outward_angle_deg, now});
+  }
+  return r;
+}
+
+}  // namespace phaco::tear

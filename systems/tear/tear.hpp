@@ -1,0 +1,106 @@
+#pragma once
+// Tearing the anterior capsule (capsulorhexis): where the tear goes next, turned into cut points
+// for the progressive cut (systems/cut), and the run-out warning.
+//
+// Two rules, selectable:
+//  - FlapForce, seed 000 §6.2: once the flap force f_t projected on the membrane at the tear tip
+//    exceeds a threshold, the next cut point is c_{t+1} = c_t + a·f_t + b·ĉ_t (ĉ_t the unit
+//    direction of the current cut segment), snapped to nearby primitives by the cut. The seed's
+//    formula gives the new point from the two vectors; we read it as the displacement from c_t,
+//    capped at max_step_mm so a sudden jerk cannot jump across the mesh in one frame.
+//  - MostStressedSpring, seed 001 §3.4: "breaking the spring exerting largest force on a vertex if
+//    it is overextended, and propagating cuts along the most stressed directions": of the springs
+//    at the tip stretched beyond break_strain, the one with the largest force breaks, and the cut
+//    runs along it to its far end.
+// An outward bias (anterior bowing of the lens diaphragm, positive posterior pressure: seed 004
+// names both as pushing the tear peripherally) adds outward_bias·|f_t|·r̂ to the flap-force step.
+//
+// Seed 004's warning: "the training software alerts the user of any potential tear problems before
+// they occur". Before each step the proposed tear direction is judged against the radial
+// direction r̂ at the tip: turning outward by more than warn_angle_deg, or heading to cross the
+// safe-zone circle (safe_radius_mm from the optical axis) within warn_lookahead_mm, raises a
+// RunoutWarning — once per excursion, re-armed when the direction turns back. A tip beyond the safe
+// radius is a runaway radial tear, recorded once as RadialTearout.
+//
+// Reads: the cut mesh (positions, springs, topology), the path's tip and direction, the flap force.
+// Writes: the cut mesh and path (through the cut), the TearState's events.
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "systems/cut/progressive_cut.hpp"
+
+namespace phaco::tear {
+
+enum class TearRule : uint8_t { FlapForce, MostStressedSpring };
+std::string_view to_string(TearRule r);
+
+struct TearSettings {
+  TearRule rule = TearRule::FlapForce;
+  double threshold_mn = 10.0;       // |f_t| needed to tear (flap-force rule)
+  double a_mm_per_mn = 0.01;        // seed 000's a
+  double b_mm = 0.05;               // seed 000's b
+  double max_step_mm = 0.15;        // cap on one step's length
+  double break_strain = 0.29;       // over-extension that breaks a spring (elongation at break, DESIGN §6)
+  double outward_bias = 0.0;        // anterior bowing: outward push per unit of |f_t| step
+  double safe_radius_mm = 3.5;      // the tear must stay inside this circle about the optical axis
+  double warn_angle_deg = 30.0;     // outward turn that warns
+  double warn_lookahead_mm = 0.75;  // warn if heading to cross the safe circle within this
+};
+
+struct TearEvent {
+  enum Kind : uint8_t { RunoutWarning, RadialTearout, Completed } kind;
+  uint64_t step;              // tear step index
+  double radius_mm;           // tip distance from the optical axis
+  double outward_angle_deg;   // of the tear direction, positive outward
+  Vec3 at;
+};
+std::string_view to_string(TearEvent::Kind k);
+
+struct TearState {
+  uint64_t steps = 0;            // tear steps attempted
+  uint64_t advances = 0;         // steps that moved the tear
+  bool warning_armed = true;     // a new warning may be raised
+  bool torn_out = false;         // a runaway radial tear happened
+  bool complete = false;         // the tear met the rim or the cut it started from
+  double max_radius_mm = 0.0;
+  Vec3 front = Vec3::Zero();     // where the flap-force rule has taken the tear (the tip follows
+  bool front_valid = false;      // it when snapping lets it)
+  std::vector<TearEvent> events;
+  uint32_t count(TearEvent::Kind k) const;
+};
+
+// Seed 004: the outward angle of a tear direction at a tip (positive = away from the axis) and
+// the distance along it to the safe circle (infinity if it does not head there).
+struct RunoutCheck {
+  double outward_angle_deg = 0.0;
+  double distance_to_safe_edge_mm = 0.0;
+  bool warn = false;
+};
+RunoutCheck check_runout(const Vec3& tip, const Vec3& direction, const TearSettings& s);
+
+// Unit normal of the membrane at a vertex (area-weighted over its fan).
+Vec3 vertex_normal(const cut::CutMesh& m, uint32_t v);
+
+// Seed 000: the displacement c_{t+1} - c_t for a flap force (mN), or zero below the threshold.
+Vec3 flap_force_step(const Vec3& tip, const Vec3& normal, const Vec3& c_hat, const Vec3& flap_force,
+                     const TearSettings& s);
+
+// Seed 001: the far end of the most stressed spring at `tip` stretched beyond break_strain, or
+// kInvalidIndex. Springs along an opened cut (boundary edges behind the tip) are skipped.
+uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const TearSettings& s);
+
+struct TearStepReport {
+  bool advanced = false;
+  bool warned = false;
+  bool torn_out = false;
+  bool completed = false;
+  cut::SegmentReport segment;
+};
+
+// One tear step from the path's tip (the path must have one: tearing continues a cut). Throws
+// std::invalid_argument for a path without a tip or a non-finite force.
+TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, const Vec3& flap_force,
+                         const TearSettings& tear, const cut::CutSettings& cut, cut::EditLog& log);
+
+}  // namespace phaco::tear

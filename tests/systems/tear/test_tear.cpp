@@ -1,0 +1,119 @@
+// The tear rules (seed 000 flap force, seed 001 most stressed spring) and seed 004's run-out check.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "systems/tear/tear.hpp"
+#include "tests/support/grid_mesh.hpp"
+#include "tests/systems/cut/cut_sheet.hpp"
+
+namespace phaco::tear {
+namespace {
+
+const Vec3 kUp(0, 0, 1);
+
+TEST(FlapForceStep, NeedsTheThresholdAndCombinesForceAndCutDirection) {
+  TearSettings s;
+  s.threshold_mn = 10.0;
+  s.a_mm_per_mn = 0.001;
+  s.b_mm = 0.02;
+  s.max_step_mm = 1.0;
+  const Vec3 tip(2, 0, 0), c_hat(0, 1, 0);
+  EXPECT_EQ(flap_force_step(tip, kUp, c_hat, Vec3(9.9, 0, 0), s), Vec3::Zero()) << "below the threshold";
+  // The normal part of the force does not count toward the threshold.
+  EXPECT_EQ(flap_force_step(tip, kUp, c_hat, Vec3(6, 0, 50), s), Vec3::Zero());
+  const Vec3 step = flap_force_step(tip, kUp, c_hat, Vec3(30, 0, 5), s);
+  EXPECT_NEAR((step - Vec3(0.03, 0.02, 0.0)).norm(), 0.0, 1e-12) << "c_{t+1} - c_t = a f + b ĉ";
+  s.max_step_mm = 0.01;
+  EXPECT_NEAR(flap_force_step(tip, kUp, c_hat, Vec3(30, 0, 5), s).norm(), 0.01, 1e-12) << "capped";
+  s.max_step_mm = 1.0;
+  s.outward_bias = 1.0;  // anterior bowing pushes the step outward (+x here)
+  EXPECT_GT(flap_force_step(tip, kUp, c_hat, Vec3(0, 30, 0), s).x(), 0.0);
+}
+
+TEST(Runout, WarnsOnOutwardTurnsAndNearTheSafeEdge) {
+  TearSettings s;
+  s.safe_radius_mm = 3.5;
+  s.warn_angle_deg = 30.0;
+  s.warn_lookahead_mm = 0.75;
+  const Vec3 tip(2.6, 0, 1);
+  EXPECT_FALSE(check_runout(tip, Vec3(0, 1, 0), s).warn) << "tangential, well inside";
+  EXPECT_NEAR(check_runout(tip, Vec3(0, 1, 0), s).outward_angle_deg, 0.0, 1e-9);
+  const RunoutCheck out = check_runout(tip, Vec3(1, 1, 0), s);
+  EXPECT_NEAR(out.outward_angle_deg, 45.0, 1e-9);
+  EXPECT_TRUE(out.warn);
+  EXPECT_FALSE(check_runout(tip, Vec3(-1, 1, 0), s).warn) << "turning inward";
+  EXPECT_TRUE(check_runout(Vec3(3.45, 0, 0), Vec3(0, 1, 0), s).warn) << "tangential but about to leave";
+  EXPECT_NEAR(check_runout(Vec3(3.0, 0, 0), Vec3(1, 0, 0), s).distance_to_safe_edge_mm, 0.5, 1e-12);
+}
+
+// A 7 × 7 unit grid cut from (1.5, 3) to the vertex (3, 3), then two of the tip's neighbours
+// pulled away so that one spring at the tip is over-extended and another only stretched.
+TEST(MostStressedSpring, BreaksTheOverExtendedSpringWithTheLargestForce) {
+  cut::test::CutSheet s = cut::test::cut_sheet(phaco::test::grid_mesh(7, 0.0), 0.0);
+  cut::CutMesh m = s.mesh();
+  cut::CutPath path;
+  cut::EditLog log;
+  cut::CutSettings cs;
+  cut::cut_towards(m, path, Vec3(1.5, 3.0, 0), cs, log);
+  cut::cut_towards(m, path, Vec3(3.0, 3.0, 0), cs, log);  // tip at vertex (3, 3) = 24
+  ASSERT_EQ(path.tip, 24u);
+  TearSettings t;
+  t.rule = TearRule::MostStressedSpring;
+  t.break_strain = 0.29;
+  EXPECT_EQ(most_stressed_spring_end(m, path.tip, t), kInvalidIndex) << "nothing over-extended yet";
+  // Pull (4, 3) = 25 away by 40 % of the edge and (3, 4) = 31 by 20 %: only the first breaks.
+  s.particles.x[25] += 0.4f;
+  s.particles.y[31] += 0.2f;
+  EXPECT_EQ(most_stressed_spring_end(m, path.tip, t), 25u);
+  TearState state;
+  const TearStepReport r = tear_step(m, path, state, Vec3::Zero(), t, cs, log);
+  EXPECT_TRUE(r.advanced);
+  EXPECT_EQ(path.tip, 25u) << "the tear runs along the broken spring";
+  EXPECT_EQ(r.segment.cut_case, cut::CutCase::SC3);
+  EXPECT_EQ(most_stressed_spring_end(m, path.tip, t), kInvalidIndex);
+  // The broken spring is gone from the joined edges: the lips of the cut hold two springs now.
+  EXPECT_TRUE(cut::test::sound(s));
+}
+
+TEST(TearStep, WarnsOncePerOutwardExcursionAndRecordsTheTearOutOnce) {
+  cut::test::CutSheet s = cut::test::cut_sheet(phaco::test::grid_mesh(12, 0.1), 0.0);
+  cut::CutMesh m = s.mesh();
+  cut::CutPath path;
+  cut::EditLog log;
+  cut::CutSettings cs;
+  // Axis at the grid's corner (0, 0): the tear starts at radius ≈ 4 and heads outward.
+  cut::cut_towards(m, path, Vec3(2.9, 2.0, 0), cs, log);
+  cut::cut_towards(m, path, Vec3(3.0, 2.9, 0), cs, log);
+  TearSettings t;
+  t.safe_radius_mm = 5.0;
+  t.threshold_mn = 1.0;
+  t.a_mm_per_mn = 0.01;
+  t.b_mm = 0.0;
+  t.max_step_mm = 0.3;
+  TearState state;
+  for (int k = 0; k < 20 && !state.complete; ++k) tear_step(m, path, state, Vec3(30, 30, 0), t, cs, log);
+  EXPECT_EQ(state.count(TearEvent::RunoutWarning), 1u);
+  EXPECT_EQ(state.count(TearEvent::RadialTearout), 1u);
+  ASSERT_FALSE(state.events.empty());
+  EXPECT_EQ(state.events.front().kind, TearEvent::RunoutWarning);
+  EXPECT_LT(state.events.front().radius_mm, t.safe_radius_mm);
+  EXPECT_GT(state.max_radius_mm, t.safe_radius_mm);
+  EXPECT_TRUE(cut::test::sound(s));
+}
+
+TEST(TearStep, RefusesToTearWithoutACutOrWithABadForce) {
+  cut::test::CutSheet s = cut::test::cut_sheet(phaco::test::grid_mesh(5, 0.0));
+  cut::CutMesh m = s.mesh();
+  cut::CutPath path;
+  cut::EditLog log;
+  TearState state;
+  EXPECT_THROW(tear_step(m, path, state, Vec3(20, 0, 0), {}, {}, log), std::invalid_argument);
+  cut::cut_towards(m, path, Vec3(1.2, 1.3, 0), {}, log);
+  cut::cut_towards(m, path, Vec3(2.3, 1.6, 0), {}, log);
+  EXPECT_THROW(tear_step(m, path, state, Vec3(std::nan(""), 0, 0), {}, {}, log), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace phaco::tear
