@@ -5,6 +5,8 @@
 //   phaco-perf membrane     issue 3: membrane step cost per level × threads × method, thread
 //                           scaling, spring pass vs bandwidth, active set, Bullet btSoftBody peer,
 //                           speed versus accuracy, stability map
+//   phaco-perf cut          issue 4: cut and tear step cost per capsule level, cut fidelity
+//                           (Hausdorff, remeshing), scripted capsulorhexis opening per level
 //   phaco-perf all          every study above, in that order
 //
 // Every study takes --quick (small levels, few steps, about a minute) and --out-dir DIR (default
@@ -41,8 +43,12 @@ studies:
       Membrane step cost for levels 0..L (default 7, quick 3) × threads 1, 2 × method; fitted
       slope; thread scaling; spring pass against the memory bandwidth; grasp with an active node
       set; Bullet btSoftBody on the same mesh; speed against accuracy; stability map.
+  cut
+      Cost of one cut step and one tear step on capsules of levels 0..6 (quick 3), both layouts;
+      the cut's Hausdorff distance to the tool path, triangles added with and without remeshing,
+      and the scripted capsulorhexis's opening (diameter, circularity, centring) per level.
   all
-      foundation, bandwidth, membrane.
+      foundation, bandwidth, membrane, cut.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -77,11 +83,14 @@ int main(int argc, char** argv) {
       perf::run_bandwidth(options);
     } else if (cmd == "membrane") {
       perf::run_membrane(options);
+    } else if (cmd == "cut") {
+      perf::run_cut(options);
     } else if (cmd == "all") {
       if (!options.extra.empty()) throw InputError("all: unknown option '" + options.extra[0] + "'");
       perf::run_foundation(options);
       perf::run_bandwidth(options);
       perf::run_membrane(options);
+      perf::run_cut(options);
     } else {
       std::fprintf(stderr, "phaco-perf: unknown study '%s' (try --help)\n", cmd.c_str());
       return 2;

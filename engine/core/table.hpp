@@ -42,6 +42,11 @@ class SlotIndex {
   uint32_t append(uint32_t n);
   // Tombstones slot i. Removing a dead slot is a no-op that returns false.
   bool release(uint32_t i);
+  // Room for n slots without reallocating (columns are reserved by their owner).
+  void reserve(uint32_t n) {
+    generation_.reserve(n);
+    alive_.reserve(n);
+  }
   // Closes the holes; generations move with their elements.
   Remap compact();
   void clear();

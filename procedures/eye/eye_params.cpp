@@ -63,6 +63,8 @@ const std::vector<std::string_view>& required_eye_keys() {
                                                      "cornea.anterior_radius_mm",
                                                      "cornea.posterior_radius_mm",
                                                      "cornea.limbus_diameter_mm",
+                                                     "cornea.youngs_modulus_kpa",
+                                                     "cornea.density_kg_m3",
                                                      "globe.axial_length_mm",
                                                      "globe.radius_mm",
                                                      "tools.phaco_tip_diameter_mm",

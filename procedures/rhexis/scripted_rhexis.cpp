@@ -14,15 +14,26 @@ double polar_angle(const Vec3& p) { return std::atan2(p.y(), p.x()); }
 }  // namespace
 
 Vec3 surface_below(const cut::CutMesh& m, double x, double y, uint32_t& hint, const cut::SnapSettings& snap) {
-  double z = 10.0;
-  Vec3 at(x, y, z);
-  for (int k = 0; k < 4; ++k) {
-    const cut::CutPoint c = cut::locate_cut_point(m.particles, m.triangles, m.topology.adjacency, hint, Vec3(x, y, z), snap);
-    hint = c.triangle;
-    at = c.position;
-    z = c.position.z();
+  // The capsule is a height field over the iris plane: the highest triangle over (x, y) holds the
+  // point. A scan (scripting only, outside any timed step); off the mesh, the nearest point.
+  const Triangles& tr = m.triangles;
+  double best_z = -1e300;
+  for (uint32_t t = 0; t < tr.slots.size(); ++t) {
+    if (!tr.slots.alive(t)) continue;
+    const Vec3 a = cut::particle_position(m.particles, tr.a[t]), b = cut::particle_position(m.particles, tr.b[t]),
+               c = cut::particle_position(m.particles, tr.c[t]);
+    const double det = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
+    if (std::abs(det) < 1e-300) continue;
+    const double u = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / det;
+    const double v = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / det;
+    if (u < -1e-12 || v < -1e-12 || u + v > 1.0 + 1e-12) continue;
+    const double z = a.z() + u * (b.z() - a.z()) + v * (c.z() - a.z());
+    if (z > best_z) best_z = z, hint = t;
   }
-  return Vec3(x, y, at.z());
+  if (best_z > -1e300) return Vec3(x, y, best_z);
+  const cut::CutPoint c = cut::locate_cut_point(m.particles, m.triangles, m.topology.adjacency, hint, Vec3(x, y, 10.0), snap);
+  hint = c.triangle;
+  return c.position;
 }
 
 RhexisResult run_scripted_rhexis(cut::CutMesh& m, const RhexisScript& s, const tear::TearSettings& tear,

@@ -49,8 +49,8 @@ struct RhexisResult {
 RhexisResult run_scripted_rhexis(cut::CutMesh& mesh, const RhexisScript& script, const tear::TearSettings& tear,
                                  const cut::CutSettings& cut);
 
-// The surface point of the mesh straight below (x, y) on the optical axis's direction (a few
-// nearest-point projections from above).
+// The surface point of the mesh straight below (x, y) along the optical axis (the highest triangle
+// over it; a scan of the mesh, for scripts), or the nearest surface point if none lies over it.
 Vec3 surface_below(const cut::CutMesh& mesh, double x, double y, uint32_t& hint, const cut::SnapSettings& snap);
 
 }  // namespace phaco::rhexis

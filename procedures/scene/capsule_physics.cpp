@@ -15,8 +15,9 @@ namespace phaco {
 
 namespace {
 
-constexpr std::array<std::string_view, 5> kCapsuleMethods = {
-    "capsule.integrator", "capsule.spring_law", "capsule.stiffness", "capsule.pretension", "capsule.active_set"};
+constexpr std::array<std::string_view, 7> kCapsuleMethods = {
+    "capsule.integrator", "capsule.spring_law", "capsule.stiffness", "capsule.pretension", "capsule.active_set",
+    "capsule.cutting",    "capsule.tear_rule"};
 
 std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback,
                           std::initializer_list<std::string_view> allowed) {
@@ -77,6 +78,7 @@ void add_capsule_physics(Scene& scene) {
   material.prestretch = params.get("capsule_model.prestretch");
   material.pretension =
       pretension == "cotangent" ? springs::Pretension::Cotangent : springs::Pretension::UniformPrestretch;
+  cp.material = material;
   cp.springs = springs::build_springs(particles, triangles, material);
   cp.blocks = springs::plan_blocks(cp.springs, particles.slots.size());
   cp.forces.resize_zero(particles.slots.size());

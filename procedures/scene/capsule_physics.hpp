@@ -13,6 +13,8 @@
 //   capsule.pretension   cotangent | uniform_prestretch         (default cotangent: isotropic
 //                        tension on any mesh, docs/membrane_accuracy.md)
 //   capsule.active_set   on | off                               (default on)
+//   capsule.cutting      on | off, capsule.tear_rule flap_force | most_stressed_spring
+//                        (procedures/scene/capsule_cutting.hpp)
 #include <nlohmann/json.hpp>
 
 #include "components/dynamics.hpp"
@@ -21,12 +23,14 @@
 #include "systems/active_nodes/active_nodes.hpp"
 #include "systems/deform/deform.hpp"
 #include "systems/grasp/grasp.hpp"
+#include "systems/springs/springs.hpp"
 
 namespace phaco {
 
 struct Scene;
 
 struct CapsulePhysics {
+  springs::SpringMaterial material;  // what the springs were built with (cutting re-springs with it)
   Springs springs;
   SpringBlocks blocks;
   Forces forces;

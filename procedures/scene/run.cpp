@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "engine/core/clock.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 
 namespace phaco {
@@ -48,6 +49,7 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
   r.elements = element_counts(*scene);
   r.state_hash = state_hash(*scene);
   if (auto capsule = capsule_physics_summary(*scene); !capsule.is_null()) r.physics["capsule"] = capsule;
+  if (auto cutting = capsule_cutting_summary(*scene); !cutting.is_null()) r.physics["capsule_cutting"] = cutting;
   r.peak_memory_mb = peak_memory_mb();
   return r;
 }

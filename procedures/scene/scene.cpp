@@ -12,6 +12,7 @@
 #include "engine/io/mesh_obj.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
 
@@ -250,6 +251,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   if (scene->body(BodyPart::Capsule)) {
     add_capsule_physics(*scene);
     systems.push_back(capsule_dynamics_system(*scene));
+    if (add_capsule_cutting(*scene)) systems.push_back(capsule_cut_system(*scene));
   }
   if (options.extra_systems) {
     for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));

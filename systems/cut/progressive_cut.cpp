@@ -135,6 +135,33 @@ bool cuttable(const CutMesh& m, uint32_t u, uint32_t v) {
   return k >= 0 && m.topology.adjacency.neighbour[tris[0]][k] == tris[1];
 }
 
+// Is v within `hops` free (boundary) edges of `tip`?
+bool own_lip(const CutMesh& m, uint32_t tip, uint32_t v, uint32_t hops) {
+  std::vector<uint32_t> frontier{tip}, seen{tip}, next, fan;
+  for (uint32_t h = 0; h < hops && !frontier.empty(); ++h) {
+    next.clear();
+    for (uint32_t u : frontier) {
+      const uint32_t hint = m.topology.vertex_triangle[u];
+      if (!m.triangles.slots.alive(hint)) continue;
+      vertex_fan(m.triangles, m.topology.adjacency, hint, u, fan);
+      for (uint32_t t : fan) {
+        const int k = corner_slot(m.triangles, t, u);
+        const auto& nb = m.topology.adjacency.neighbour[t];
+        const uint32_t ends[2] = {nb[k] == kInvalidIndex ? corner(m.triangles, t, (k + 1) % 3) : kInvalidIndex,
+                                  nb[(k + 2) % 3] == kInvalidIndex ? corner(m.triangles, t, (k + 2) % 3) : kInvalidIndex};
+        for (uint32_t w : ends) {
+          if (w == kInvalidIndex || std::find(seen.begin(), seen.end(), w) != seen.end()) continue;
+          if (w == v) return true;
+          seen.push_back(w);
+          next.push_back(w);
+        }
+      }
+    }
+    frontier.swap(next);
+  }
+  return false;
+}
+
 }  // namespace
 
 std::string_view to_string(CutCase c) {
@@ -168,8 +195,18 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     return r;
   }
   path.tool_points.push_back(tool_point);
-  const CutPoint target = locate_cut_point(m.particles, m.triangles, m.topology.adjacency, path.hint_triangle,
-                                           tool_point, s.snap);
+  CutPoint target = locate_cut_point(m.particles, m.triangles, m.topology.adjacency, path.hint_triangle,
+                                     tool_point, s.snap);
+  if (path.tip != kInvalidIndex && target.distance_mm > s.snap.vertex_snap_mm) {
+    // The walk can stop on a lip of the cut, the point lying across it: walk again from every
+    // triangle round the tip (the crack tip joins both sides), and keep the nearest.
+    std::vector<uint32_t> fan;
+    vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[path.tip], path.tip, fan);
+    for (uint32_t t : fan) {
+      const CutPoint c = locate_cut_point(m.particles, m.triangles, m.topology.adjacency, t, tool_point, s.snap);
+      if (c.distance_mm < target.distance_mm) target = c;
+    }
+  }
   path.hint_triangle = target.triangle;
   if (!path.started) {
     path.started = true;
@@ -239,6 +276,14 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
       triangles_on_edge(m, p.a, p.b, tris);
       boundary = tris.size() != 2 || !cuttable(m, p.a, p.b);
     }
+    // A boundary a few edges from the tip along the free edges is this cut's own lip: stepping
+    // onto it is going back or sideways into the incision, not cutting through (a tool lifting
+    // off, a sample just behind the tip, a flap dragged over its own cut).
+    if (boundary && path.direction.squaredNorm() > 0 &&
+        (own_lip(m, tip, p.a, s.own_lip_hops) || (p.kind == CutPoint::Edge && own_lip(m, tip, p.b, s.own_lip_hops)))) {
+      r.stalled = true;
+      break;
+    }
     const uint32_t q = realise(m, p, log);
     if (!cuttable(m, tip, q)) {  // the way runs along the rim or an opened cut
       r.reached_boundary = boundary;
@@ -285,7 +330,8 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     log.clamped_pretension += region.clamped_pretension;
   }
   if (r.reached_boundary) path.reached_boundary = true;
-  if (m.particles.slots.alive(path.tip)) path.hint_triangle = m.topology.vertex_triangle[path.tip];
+  if (!m.triangles.slots.alive(path.hint_triangle) && m.particles.slots.alive(path.tip))
+    path.hint_triangle = m.topology.vertex_triangle[path.tip];
   return r;
 }
 

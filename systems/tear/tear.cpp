@@ -127,7 +127,9 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, 
     const Vec3 step = flap_force_step(x, vertex_normal(m, tip), path.direction, flap_force, tear);
     if (step.norm() == 0.0) return r;
     // The tear front runs ahead of the tip while snapping keeps the tip waiting for a good split.
-    if (!state.front_valid) state.front = x, state.front_valid = true;
+    // (The membrane moves: a front left far behind by the tip's motion starts again at the tip.)
+    if (!state.front_valid || (state.front - x).norm() > 4.0 * tear.max_step_mm) state.front = x;
+    state.front_valid = true;
     state.front += step;
     target = state.front;
   } else {

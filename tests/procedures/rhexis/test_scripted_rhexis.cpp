@@ -5,10 +5,12 @@
 
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/eye/resolution.hpp"
+#include "procedures/rhexis/cut_fidelity.hpp"
 #include "procedures/rhexis/scripted_rhexis.hpp"
 #include "tests/systems/cut/cut_sheet.hpp"
 
@@ -70,6 +72,41 @@ TEST(OutwardPull, WarnsBeforeTheTearLeavesTheSafeZoneAndRecordsTheTearOut) {
   EXPECT_FALSE(r.opening.complete);
   EXPECT_TRUE(cut::test::sound(sheet));
 }
+
+// A straight 4 mm stroke across the capsule: the cut follows the tool to its end, within the
+// snapping distance (both ways of the Hausdorff distance), on every level and layout tested.
+class StraightCut : public ::testing::TestWithParam<std::tuple<int, eye::CapsuleLayout>> {};
+
+TEST_P(StraightCut, FollowsTheToolWithinTheSnapDistance) {
+  const auto [level, layout] = GetParam();
+  cut::test::CutSheet sheet =
+      cut::test::cut_sheet(eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout));
+  for (uint32_t v = 0; v < sheet.particles.slots.size(); ++v)
+    if (std::hypot(sheet.particles.x[v], sheet.particles.y[v]) > 0.999 * 4.5) sheet.particles.kind[v] = ParticleKind::Anchored;
+  cut::CutMesh m = sheet.mesh();
+  const cut::CutSettings settings = cut_settings();
+  cut::CutPath path;
+  cut::EditLog log;
+  uint32_t hint = 0;
+  std::vector<Vec3> tool;
+  for (int k = 0; k <= 40; ++k) {
+    tool.push_back(surface_below(m, -2.0 + 0.1 * k, -0.3 + 0.0175 * k, hint, settings.snap));
+    cut::cut_towards(m, path, tool.back(), settings, log);
+  }
+  const CutFidelity f = measure_cut_fidelity(m, tool);
+  RecordProperty("hausdorff_mm", std::to_string(f.hausdorff_mm));
+  EXPECT_GT(f.lip_edges, 20u);
+  EXPECT_LE(f.cut_to_tool_mm, path.max_snap_mm + 1e-3);
+  // The far way round samples the lips at ends and midpoints: half the longest lip of slack.
+  EXPECT_LE(f.tool_to_cut_mm, path.max_snap_mm + 0.2);
+  EXPECT_LT((cut::particle_position(sheet.particles, path.tip) - tool.back()).norm(), 0.1) << "the cut reached the end";
+  EXPECT_TRUE(cut::test::sound(sheet));
+}
+
+INSTANTIATE_TEST_SUITE_P(Capsule, StraightCut,
+                         ::testing::Combine(::testing::Values(0, 1, 2, 3),
+                                            ::testing::Values(eye::CapsuleLayout::Curvilinear,
+                                                              eye::CapsuleLayout::Isotropic)));
 
 TEST(ScriptedRhexis, RefusesABadScript) {
   cut::test::CutSheet sheet = cut::test::cut_sheet(

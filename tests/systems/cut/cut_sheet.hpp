@@ -7,36 +7,24 @@
 
 #include "engine/core/mesh_data.hpp"
 #include "systems/cut/membrane_edit.hpp"
+#include "systems/cut/membrane_sheet.hpp"
 #include "systems/cut/progressive_cut.hpp"
 #include "systems/springs/springs.hpp"
 #include "systems/topology_check/topology_check.hpp"
-#include "tests/support/membrane_tables.hpp"
 
 namespace phaco::cut::test {
 
-struct CutSheet {
-  Particles particles;
-  Triangles triangles;
-  Springs springs;
-  MembraneTopology topology;
-  MembraneMaterial material;
-
-  CutMesh mesh() { return {particles, triangles, springs, topology, material}; }
-};
+using CutSheet = MembraneSheet;
 
 // The capsule's material (E·h = 26 mN/mm, ρ·h for 1000 kg/m³ and 13 µm) with a 5 % pre-stretch.
 inline CutSheet cut_sheet(const SurfaceMesh& mesh, double prestretch = 0.05,
                           springs::Pretension pretension = springs::Pretension::Cotangent) {
-  CutSheet s;
-  s.particles = phaco::test::particles_from(mesh);
-  s.triangles = phaco::test::triangles_from(mesh);
-  s.material.springs.sheet_modulus_mn_mm = 26.0;
-  s.material.springs.prestretch = prestretch;
-  s.material.springs.pretension = pretension;
-  s.material.areal_density_kg_mm2 = 1000.0 * 1e-9 * 0.013;
-  s.springs = springs::build_springs(s.particles, s.triangles, s.material.springs);
-  s.topology = build_topology(s.particles, s.triangles, s.springs);
-  return s;
+  MembraneMaterial material;
+  material.springs.sheet_modulus_mn_mm = 26.0;
+  material.springs.prestretch = prestretch;
+  material.springs.pretension = pretension;
+  material.areal_density_kg_mm2 = 1000.0 * 1e-9 * 0.013;
+  return make_membrane_sheet(mesh, material);
 }
 
 // Item 4's invariants at their default thresholds (area ≥ 1e-8 mm², angles ≥ 1°) and the cut's own

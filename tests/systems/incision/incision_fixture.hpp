@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "tests/support/expect_invalid.hpp"
 #include "procedures/eye/eye_geometry.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "systems/incision/keratome.hpp"
@@ -43,16 +44,6 @@ inline double line_sphere_far_root(const Vec3& p, const Vec3& d, double cz, doub
   return t1 > 0 ? t1 : t2;
 }
 
-// Runs f and expects std::invalid_argument whose message names `field`.
-template <class F>
-void expect_invalid(F&& f, const std::string& field) {
-  try {
-    f();
-    ADD_FAILURE() << "expected std::invalid_argument naming '" << field << "'";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos)
-        << "message '" << e.what() << "' does not name '" << field << "'";
-  }
-}
+using phaco::test::expect_invalid;
 
 }  // namespace phaco::incision::test

@@ -1,0 +1,230 @@
+#include "procedures/incision/scripted_incision.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace phaco::corneal_incision {
+namespace {
+
+// An end is fed when it lies further from the puncture than the last one fed by more than this
+// (a blade resting fully in, or withdrawing, cuts nothing more).
+constexpr double kWidenMm = 1e-9;
+
+struct SidePath {
+  cut::CutPath path;
+  double reach_mm = 0.0;  // distance from the puncture of the last end fed
+};
+
+// The two paths of one surface (0 = left, 1 = right), growing from its puncture.
+struct SurfaceCutter {
+  bool started = false;
+  Vec3 puncture = Vec3::Zero();
+  SidePath side[2];
+};
+
+void require_positive(double v, const char* field) {
+  if (!std::isfinite(v) || !(v > 0.0))
+    throw std::invalid_argument(std::string("scripted incision: ") + field +
+                                " must be a finite positive number (mm)");
+}
+
+// Feeds `end` to a side's path if the cut widens there; true if the mesh changed.
+bool feed(cut::CutMesh& m, SurfaceCutter& s, int side, const Vec3& end,
+          const cut::CutSettings& settings, cut::EditLog& log, uint32_t& segments) {
+  SidePath& p = s.side[side];
+  if (p.path.reached_boundary) return false;
+  const double d = (end - s.puncture).norm();
+  if (d <= p.reach_mm + kWidenMm) return false;
+  p.reach_mm = d;
+  const cut::SegmentReport r = cut::cut_towards(m, p.path, end, settings, log);
+  if (r.made) ++segments;
+  return r.made;
+}
+
+// One frame on one surface: start both paths at the puncture once the tip is through, then feed
+// this frame's section ends. True if the mesh changed.
+bool cut_surface(cut::CutMesh& m, SurfaceCutter& s, const incision::BladeSection& sec,
+                 const cut::CutSettings& settings, cut::EditLog& log, uint32_t& segments) {
+  if (!sec.touches) return false;
+  SidePath& left = s.side[0];
+  SidePath& right = s.side[1];
+  if (!s.started) {
+    if (!sec.has_puncture) return false;
+    s.started = true;
+    s.puncture = sec.puncture;
+    // A walk from an arbitrary triangle could settle on the other cap of the closed shell (a
+    // local minimum of the distance): start from the nearest triangle, found once by a scan.
+    left.path.hint_triangle = cut::locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
+                                                    kInvalidIndex, s.puncture, settings.snap)
+                                  .triangle;
+    cut::cut_towards(m, left.path, s.puncture, settings, log);
+  }
+  bool made = feed(m, s, 0, sec.left, settings, log, segments);
+  // The right path starts where the left one made the puncture a vertex, so both are one cut.
+  if (!right.path.started && !left.path.sources.empty()) {
+    const uint32_t c0 = left.path.sources.front();
+    if (m.particles.slots.alive(c0)) {
+      right.path.hint_triangle = m.topology.vertex_triangle[c0];
+      cut::cut_towards(m, right.path, cut::particle_position(m.particles, c0), settings, log);
+    }
+  }
+  if (right.path.started) made = feed(m, s, 1, sec.right, settings, log, segments) || made;
+  return made;
+}
+
+// The shoulders have passed the sphere: both ends lie on the blade's sides (full width).
+bool full_width(const incision::BladeSection& s) {
+  return s.touches && s.left_edge == incision::OutlineEdge::LeftSide &&
+         s.right_edge == incision::OutlineEdge::RightSide;
+}
+
+// The tool polyline of one surface: the left ends fed (outermost first), the puncture, the right
+// ends.
+std::vector<Vec3> tool_polyline(const SurfaceCutter& s) {
+  std::vector<Vec3> out;
+  if (!s.started) return out;
+  const auto& l = s.side[0].path.tool_points;
+  const auto& r = s.side[1].path.tool_points;
+  for (size_t k = l.size(); k-- > 1;) out.push_back(l[k]);
+  out.push_back(s.puncture);
+  for (size_t k = 1; k < r.size(); ++k) out.push_back(r[k]);  // r[0] is the puncture's vertex
+  return out;
+}
+
+// The blade has stopped, so no later sample will come for a path whose tip waits short of its
+// last end (the cutter refused every placement there). It gets that end again, first with the
+// finishing quality bound; if it still waits, with a vertex snap just under its gap, so the end
+// goes to a vertex nearer the blade's end than the tip is, if there is one in the way (the cut may
+// then pass the end by less than it would have fallen short). True if the mesh changed.
+bool finish(cut::CutMesh& m, SurfaceCutter& s, const cut::CutSettings& settings,
+            double min_angle_deg, cut::EditLog& log, uint32_t& segments) {
+  bool made = false;
+  for (SidePath& p : s.side) {
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      const cut::CutPath& path = p.path;
+      if (path.tip == kInvalidIndex || path.reached_boundary || path.tool_points.size() < 2) break;
+      const Vec3 end = path.tool_points.back();
+      const double gap = (cut::particle_position(m.particles, path.tip) - end).norm();
+      if (gap <= settings.snap.vertex_snap_mm) break;
+      cut::CutSettings relaxed = settings;
+      relaxed.min_angle_deg = std::min(settings.min_angle_deg, min_angle_deg);
+      if (attempt == 1) relaxed.snap.vertex_snap_mm = gap * (1.0 - 1e-9);
+      const cut::SegmentReport r = cut::cut_towards(m, p.path, end, relaxed, log);
+      if (r.made) ++segments, made = true;
+    }
+  }
+  return made;
+}
+
+uint32_t live_tip(const cut::CutMesh& m, const cut::CutPath& p) {
+  return p.tip != kInvalidIndex && m.particles.slots.alive(p.tip) ? p.tip : kInvalidIndex;
+}
+
+}  // namespace
+
+IncisionResult run_scripted_incision(cut::CutMesh& m, const incision::CorneaSpheres& spheres,
+                                     const IncisionScript& script,
+                                     const cut::CutSettings& settings) {
+  incision::check_spheres(spheres);
+  require_positive(script.step_mm, "step_mm");
+  require_positive(script.measure_sample_mm, "measure_sample_mm");
+  if (!std::isfinite(script.finish_min_angle_deg) ||
+      (script.finish_min_angle_deg != 0.0 && !(script.finish_min_angle_deg >= 1.0)))
+    throw std::invalid_argument(
+        "scripted incision: finish_min_angle_deg must be 0 (no finishing) or >= 1 (the invariants' "
+        "minimum angle, degrees)");
+  if (!std::isfinite(script.max_advance_mm) || script.max_advance_mm < 0.0)
+    throw std::invalid_argument(
+        "scripted incision: max_advance_mm must be finite and >= 0 (0: the blade length)");
+  incision::KeratomeBlade blade =
+      incision::incision_start_blade(spheres.anterior_centre_z, spheres.anterior_radius_mm,
+                                     spheres.limbus_radius_mm, script.approach, script.shape);
+  const incision::BladeFrame frame = incision::blade_frame(blade);
+  const Vec3 start = frame.tip;
+  const double max_advance =
+      script.max_advance_mm > 0.0 ? script.max_advance_mm : script.shape.length_mm;
+
+  IncisionResult out;
+  out.triangles_before = m.triangles.slots.live_count();
+  out.particles_before = m.particles.slots.live_count();
+
+  incision::WoundTracker tracker;
+  SurfaceCutter outer, inner;
+  cut::EditLog log;
+  double total_ms = 0.0, cutting_ms = 0.0;
+  const auto steps = static_cast<uint32_t>(std::floor(max_advance / script.step_mm + 1e-9));
+  uint32_t last = 0;
+  for (uint32_t k = 0; k <= steps; ++k) {
+    last = k;
+    blade.tip = start + (k * script.step_mm) * frame.d;
+    const auto t0 = std::chrono::steady_clock::now();
+    const incision::WoundFrame now = incision::update_wound(tracker, blade, spheres);
+    bool made = cut_surface(m, outer, now.outer, settings, log, out.segments);
+    made = cut_surface(m, inner, now.inner, settings, log, out.segments) || made;
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    log.clear();
+    total_ms += ms;
+    out.frame_ms_max = std::max(out.frame_ms_max, ms);
+    ++out.frames;
+    if (made) ++out.cutting_frames, cutting_ms += ms;
+    if (full_width(now.outer) && full_width(now.inner)) {
+      out.passed = true;
+      break;
+    }
+  }
+  out.advance_mm = last * script.step_mm;
+  if (script.finish_min_angle_deg > 0.0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    out.finished = finish(m, outer, settings, script.finish_min_angle_deg, log, out.segments);
+    out.finished =
+        finish(m, inner, settings, script.finish_min_angle_deg, log, out.segments) || out.finished;
+    log.clear();
+    out.finish_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  out.frame_ms_mean = out.frames ? total_ms / out.frames : 0.0;
+  out.cutting_frame_ms_mean = out.cutting_frames ? cutting_ms / out.cutting_frames : 0.0;
+
+  // The tool leaves the mesh: remember the crack tips, end every path, withdraw the blade.
+  const uint32_t outer_tips[2] = {live_tip(m, outer.side[0].path), live_tip(m, outer.side[1].path)};
+  const uint32_t inner_tips[2] = {live_tip(m, inner.side[0].path), live_tip(m, inner.side[1].path)};
+  for (SurfaceCutter* s : {&outer, &inner}) {
+    for (SidePath& p : s->side) cut::end_cut(p.path);
+  }
+  out.outer_max_snap_mm = std::max(outer.side[0].path.max_snap_mm, outer.side[1].path.max_snap_mm);
+  out.inner_max_snap_mm = std::max(inner.side[0].path.max_snap_mm, inner.side[1].path.max_snap_mm);
+  for (uint32_t k = last; k-- > 0;) {
+    blade.tip = start + (k * script.step_mm) * frame.d;
+    incision::update_wound(tracker, blade, spheres);
+  }
+  out.wound = tracker.wound;
+  out.port = tracker.port;
+  out.triangles_after = m.triangles.slots.live_count();
+  out.particles_after = m.particles.slots.live_count();
+
+  out.outer = measure_surface_cut(m, spheres, Surface::Anterior, outer_tips[0], outer_tips[1],
+                                  tool_polyline(outer), script.measure_sample_mm);
+  out.inner = measure_surface_cut(m, spheres, Surface::Posterior, inner_tips[0], inner_tips[1],
+                                  tool_polyline(inner), script.measure_sample_mm);
+  if (out.outer.exists) {
+    const Vec3& c = out.outer.middle;
+    out.mesh_clock_hour = incision::clock_hour_of(c);
+    out.mesh_limbus_distance_mm = spheres.limbus_radius_mm - std::hypot(c.x(), c.y());
+  }
+  if (out.outer.exists && out.inner.exists) {
+    const Vec3 d = out.inner.middle - out.outer.middle;
+    out.mesh_tunnel_length_mm = d.norm();
+    if (out.mesh_tunnel_length_mm > 0.0)
+      out.mesh_entry_angle_deg =
+          std::asin(std::clamp(-d.z() / out.mesh_tunnel_length_mm, -1.0, 1.0)) * 180.0 /
+          std::numbers::pi;
+  }
+  return out;
+}
+
+}  // namespace phaco::corneal_incision

@@ -1,0 +1,200 @@
+#include "procedures/scene/capsule_cutting.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "components/particles.hpp"
+#include "components/tool.hpp"
+#include "components/triangles.hpp"
+#include "engine/core/error.hpp"
+#include "procedures/rhexis/opening.hpp"
+#include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/scene.hpp"
+#include "systems/cut/spring_order.hpp"
+#include "systems/springs/springs.hpp"
+
+namespace phaco {
+
+namespace {
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+// The force the forceps exert on the flap through the particle they hold: the pull of that
+// particle's springs into the membrane, reversed (the held particle is kinematic, so the tool
+// balances it).
+Vec3 flap_force(const cut::CutMesh& m, uint32_t held) {
+  std::vector<uint32_t> fan;
+  const uint32_t hint = m.topology.vertex_triangle[held];
+  if (!m.triangles.slots.alive(hint)) return Vec3::Zero();
+  cut::vertex_fan(m.triangles, m.topology.adjacency, hint, held, fan);
+  std::vector<uint32_t> seen;
+  Vec3 pull = Vec3::Zero();
+  const Vec3 x = cut::particle_position(m.particles, held);
+  for (uint32_t t : fan) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t n = cut::corner(m.triangles, t, k);
+      if (n == held || std::find(seen.begin(), seen.end(), n) != seen.end()) continue;
+      seen.push_back(n);
+      const auto it = m.topology.spring_of_edge.find(cut::edge_key(held, n));
+      if (it == m.topology.spring_of_edge.end()) continue;
+      const Vec3 d = cut::particle_position(m.particles, n) - x;
+      const double len = d.norm();
+      if (len <= 0) continue;
+      pull += m.springs.stiffness[it->second] * (len - m.springs.rest_length[it->second]) * (d / len);
+    }
+  }
+  return -pull;
+}
+
+// Brings the capsule's physics up to date after this frame's edits.
+void refresh_physics(cut::CutMesh& m, CapsulePhysics& cp, const cut::EditLog& log) {
+  cut::compact_and_sort_springs(m);
+  const uint32_t n = m.particles.slots.size();
+  cp.forces.resize_zero(n);
+  cp.glue.x.resize(n), cp.glue.y.resize(n), cp.glue.z.resize(n);
+  for (uint32_t v : log.new_particles) {
+    if (v >= n) continue;
+    const Vec3 r = cut::rest_position(m.topology, v);
+    cp.glue.x[v] = static_cast<float>(r.x()), cp.glue.y[v] = static_cast<float>(r.y()),
+    cp.glue.z[v] = static_cast<float>(r.z());
+  }
+  cp.blocks = springs::plan_blocks(cp.springs, n);
+  cp.graph = springs::build_spring_graph(cp.springs, n);
+  cp.state.implicit.invalidate();
+}
+
+}  // namespace
+
+bool add_capsule_cutting(Scene& scene) {
+  const auto choice = [&](const std::string& key, const std::string& fallback,
+                          std::initializer_list<std::string_view> allowed) {
+    const auto it = scene.scenario.methods.find(key);
+    if (it == scene.scenario.methods.end()) return fallback;
+    for (std::string_view a : allowed)
+      if (it->second == a) return it->second;
+    throw InputError(scene.scenario.source + ": methods[\"" + key + "\"]: unknown choice '" + it->second + "'");
+  };
+  if (choice("capsule.cutting", "on", {"on", "off"}) == "off") return false;
+  const std::string rule = choice("capsule.tear_rule", "flap_force", {"flap_force", "most_stressed_spring"});
+
+  const Entity capsule = *scene.body(BodyPart::Capsule);
+  Particles& p = scene.world.at<Particles>(capsule);
+  Triangles& tr = scene.world.at<Triangles>(capsule);
+  CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
+  CapsuleCutting cc;
+  cc.material.springs = cp.material;
+  cc.material.areal_density_kg_mm2 =
+      scene.params.get("capsule.density_kg_m3") * 1e-9 * scene.params.get("capsule.thickness_mm");
+  cc.topology = cut::build_topology(p, tr, cp.springs);
+  cc.tear.rule = rule == "flap_force" ? tear::TearRule::FlapForce : tear::TearRule::MostStressedSpring;
+  double edge = 0.0;
+  uint32_t counted = 0;
+  for (uint32_t t = 0; t < tr.slots.size(); ++t) {
+    if (!tr.slots.alive(t)) continue;
+    edge += (cut::particle_position(p, tr.a[t]) - cut::particle_position(p, tr.b[t])).norm();
+    ++counted;
+  }
+  edge /= std::max<uint32_t>(counted, 1);
+  cc.cut.snap.vertex_snap_mm = std::min(0.02, 0.1 * edge);
+  cc.cut.snap.edge_snap_mm = std::min(0.01, 0.05 * edge);
+  cc.cut.remesh = false;  // no particle may disappear under the dynamics' feet
+  cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
+  cut::reserve_for_cuts(m, std::max<uint32_t>(4096, p.slots.size() / 4));
+  scene.world.add(capsule, std::move(cc));
+  return true;
+}
+
+SystemDesc capsule_cut_system(Scene& scene) {
+  const Entity capsule = *scene.body(BodyPart::Capsule);
+  return {.name = "capsule_cut",
+          .phase = Phase::Topology,
+          .reads = {"tools.pose", "tools.grasp"},
+          .writes = {"capsule.particles", "capsule.triangles", "capsule.physics"},
+          .run = [&scene, capsule](const FrameContext&) {
+            Particles& p = scene.world.at<Particles>(capsule);
+            Triangles& tr = scene.world.at<Triangles>(capsule);
+            CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
+            CapsuleCutting& cc = scene.world.at<CapsuleCutting>(capsule);
+            cc.log.clear();
+            ++cc.frames;
+            cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
+            const auto t0 = std::chrono::steady_clock::now();
+            bool cystotome_cutting = false;
+            for (Entity tool : scene.tools) {
+              if (scene.world.at<Tool>(tool).kind != ToolKind::Cystotome) continue;
+              const Vec3 tip = scene.world.at<ToolState>(tool).pos;
+              const cut::CutPoint c =
+                  cut::locate_cut_point(p, tr, cc.topology.adjacency, cc.stroke.hint_triangle, tip, cc.cut.snap);
+              // In contact: at the surface, or through it (the tip pressed into the capsule).
+              const uint32_t t = c.triangle;
+              const Vec3 a = cut::particle_position(p, tr.a[t]);
+              const Vec3 normal = (cut::particle_position(p, tr.b[t]) - a).cross(cut::particle_position(p, tr.c[t]) - a);
+              const bool through = (tip - c.position).dot(normal) < 0.0 && c.distance_mm <= cc.penetration_mm;
+              if (c.distance_mm <= cc.contact_mm || through) {
+                cystotome_cutting = true;
+                cc.cut_segments += cut::cut_towards(m, cc.stroke, tip, cc.cut, cc.log).made;
+              } else if (cc.stroke.started) {  // the tip left the capsule: the stroke ends
+                if (cc.stroke.tip != kInvalidIndex) cc.flap = cc.stroke, cc.tear_state = {};
+                cc.stroke = {};
+              }
+            }
+            // The tear: from the flap's tip, pulled by a forceps that holds the capsule.
+            if (!cystotome_cutting && cc.flap.tip != kInvalidIndex && p.slots.alive(cc.flap.tip) &&
+                !cc.tear_state.complete) {
+              for (Entity tool : scene.tools) {
+                const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
+                if (!g || !g->capsule.holding() || !p.slots.alive(g->capsule.particle)) continue;
+                tear::tear_step(m, cc.flap, cc.tear_state, flap_force(m, g->capsule.particle), cc.tear, cc.cut, cc.log);
+                break;
+              }
+            }
+            const double edit_ms = elapsed_ms(t0);
+            cc.edit_ms_total += edit_ms;
+            cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);
+            if (cc.log.touched_triangles.empty() && cc.log.new_particles.empty() && cc.log.opened_edges == 0) return;
+            const auto t1 = std::chrono::steady_clock::now();
+            refresh_physics(m, cp, cc.log);
+            const double refresh_ms = elapsed_ms(t1);
+            cc.refresh_ms_total += refresh_ms;
+            cc.refresh_ms_max = std::max(cc.refresh_ms_max, refresh_ms);
+            ++cc.topology_changes;
+          }};
+}
+
+nlohmann::json capsule_cutting_summary(Scene& scene) {
+  const auto capsule = scene.body(BodyPart::Capsule);
+  if (!capsule) return nullptr;
+  CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
+  if (!cc) return nullptr;
+  CapsulePhysics& cp = scene.world.at<CapsulePhysics>(*capsule);
+  const cut::CutMesh m{scene.world.at<Particles>(*capsule), scene.world.at<Triangles>(*capsule), cp.springs,
+                       cc->topology, cc->material};
+  const rhexis::Opening o = rhexis::measure_opening(m);
+  const tear::TearState& ts = cc->tear_state;
+  nlohmann::json j = {{"cut_segments", cc->cut_segments},
+                      {"topology_changes", cc->topology_changes},
+                      {"tear_rule", std::string(tear::to_string(cc->tear.rule))},
+                      {"tear_steps", ts.steps},
+                      {"tear_advances", ts.advances},
+                      {"tear_complete", ts.complete},
+                      {"runout_warnings", ts.count(tear::TearEvent::RunoutWarning)},
+                      {"radial_tearouts", ts.count(tear::TearEvent::RadialTearout)},
+                      {"max_tear_radius_mm", ts.max_radius_mm},
+                      {"edit_ms_mean_per_frame", cc->frames ? cc->edit_ms_total / double(cc->frames) : 0.0},
+                      {"edit_ms_max", cc->edit_ms_max},
+                      {"physics_refresh_ms_mean",
+                       cc->topology_changes ? cc->refresh_ms_total / double(cc->topology_changes) : 0.0},
+                      {"physics_refresh_ms_max", cc->refresh_ms_max},
+                      {"opening_complete", o.complete}};
+  if (o.complete) {
+    j["opening_diameter_mm"] = o.diameter_mm;
+    j["opening_circularity"] = o.circularity;
+    j["opening_centering_mm"] = o.centering_mm;
+  }
+  return j;
+}
+
+}  // namespace phaco

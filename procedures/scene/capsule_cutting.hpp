@@ -1,0 +1,53 @@
+#pragma once
+// Cutting and tearing the anterior capsule in the running scene (issue 4): the cystotome cuts
+// where its tip touches the capsule (seed 000 §5.2 progressive cut: a cut point per frame while
+// in contact, the path ends when the tip leaves), and a forceps holding the flap tears it
+// (systems/tear) from the tip of the last cystotome cut, with the force the forceps exerts on the
+// flap — the pull of the grasped particle's springs, reversed — as seed 000's f_t.
+//
+// Runs in the topology phase, before the dynamics: it edits the capsule's tables through a
+// CutMesh (local edits), then, if anything changed, brings the physics up to date — the spring
+// table is compacted and sorted again, the spring graph, blocks, glue and scratch arrays are
+// rebuilt for the new particle count (a pass over the whole capsule: see docs/cutting_and_tearing.md
+// for its cost). Remeshing is off in the scene so that no particle is removed.
+//
+// Methods (scenario `methods`): capsule.cutting on | off (default on); capsule.tear_rule
+// flap_force | most_stressed_spring (default flap_force).
+#include <nlohmann/json.hpp>
+
+#include "engine/schedule/system.hpp"
+#include "systems/cut/progressive_cut.hpp"
+#include "systems/tear/tear.hpp"
+
+namespace phaco {
+
+struct Scene;
+
+struct CapsuleCutting {
+  cut::MembraneTopology topology;
+  cut::MembraneMaterial material;
+  cut::CutSettings cut;
+  tear::TearSettings tear;
+  double contact_mm = 0.05;      // cystotome tip this close to the capsule cuts,
+  double penetration_mm = 0.5;   // and so does one pressed up to this far through it
+  cut::CutPath stroke;           // the cystotome's current path
+  cut::CutPath flap;             // the path the tear continues (the last stroke with a tip)
+  tear::TearState tear_state;
+  cut::EditLog log;              // this frame's edits (cleared each frame)
+  uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
+  double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics rebuild after changes
+  double edit_ms_total = 0.0, edit_ms_max = 0.0;        // the local edits themselves
+};
+
+// Adds CapsuleCutting to the capsule (after add_capsule_physics) unless methods say
+// capsule.cutting = off; returns whether it did.
+bool add_capsule_cutting(Scene& scene);
+
+// The topology-phase system: reads tools.pose, writes capsule.particles, capsule.triangles and
+// capsule.physics.
+SystemDesc capsule_cut_system(Scene& scene);
+
+// For the run report: cuts, tear events, and the opening if the disc came free.
+nlohmann::json capsule_cutting_summary(Scene& scene);
+
+}  // namespace phaco
