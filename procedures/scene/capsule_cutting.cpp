@@ -101,8 +101,11 @@ bool add_capsule_cutting(Scene& scene) {
   cc.cut.snap.vertex_snap_mm = std::min(0.02, 0.1 * edge);
   cc.cut.snap.edge_snap_mm = std::min(0.01, 0.05 * edge);
   cc.cut.remesh = false;  // no particle may disappear under the dynamics' feet
+  cc.rest_x = p.x, cc.rest_y = p.y, cc.rest_z = p.z;
   cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
-  cut::reserve_for_cuts(m, std::max<uint32_t>(4096, p.slots.size() / 4));
+  const uint32_t extra = std::max<uint32_t>(4096, p.slots.size() / 4);
+  cut::reserve_for_cuts(m, extra);
+  for (auto* v : {&cc.rest_x, &cc.rest_y, &cc.rest_z}) v->reserve(p.slots.size() + extra);
   scene.world.add(capsule, std::move(cc));
   return true;
 }
@@ -122,7 +125,9 @@ SystemDesc capsule_cut_system(Scene& scene) {
             ++cc.frames;
             cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
             const auto t0 = std::chrono::steady_clock::now();
+            // What the tools do, seen on the deformed capsule.
             bool cystotome_cutting = false;
+            Vec3 cystotome_rest = Vec3::Zero();
             for (Entity tool : scene.tools) {
               if (scene.world.at<Tool>(tool).kind != ToolKind::Cystotome) continue;
               const Vec3 tip = scene.world.at<ToolState>(tool).pos;
@@ -135,21 +140,44 @@ SystemDesc capsule_cut_system(Scene& scene) {
               const bool through = (tip - c.position).dot(normal) < 0.0 && c.distance_mm <= cc.penetration_mm;
               if (c.distance_mm <= cc.contact_mm || through) {
                 cystotome_cutting = true;
-                cc.cut_segments += cut::cut_towards(m, cc.stroke, tip, cc.cut, cc.log).made;
+                for (int k = 0; k < 3; ++k) cystotome_rest += c.bary[k] * cut::rest_position(cc.topology, cut::corner(tr, t, k));
               } else if (cc.stroke.started) {  // the tip left the capsule: the stroke ends
                 if (cc.stroke.tip != kInvalidIndex) cc.flap = cc.stroke, cc.tear_state = {};
                 cc.stroke = {};
               }
             }
-            // The tear: from the flap's tip, pulled by a forceps that holds the capsule.
-            if (!cystotome_cutting && cc.flap.tip != kInvalidIndex && p.slots.alive(cc.flap.tip) &&
-                !cc.tear_state.complete) {
+            Vec3 pull = Vec3::Zero();
+            const bool tearing = !cystotome_cutting && cc.flap.tip != kInvalidIndex && p.slots.alive(cc.flap.tip) &&
+                                 !cc.tear_state.complete;
+            bool pulled = false;
+            if (tearing) {
               for (Entity tool : scene.tools) {
                 const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
                 if (!g || !g->capsule.holding() || !p.slots.alive(g->capsule.particle)) continue;
-                tear::tear_step(m, cc.flap, cc.tear_state, flap_force(m, g->capsule.particle), cc.tear, cc.cut, cc.log);
+                pull = flap_force(m, g->capsule.particle);
+                pulled = true;
                 break;
               }
+            }
+            if (!cystotome_cutting && !pulled) {
+              cc.edit_ms_total += elapsed_ms(t0);
+              return;
+            }
+            // The edits, in the rest shape.
+            std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
+            if (cystotome_cutting) cc.cut_segments += cut::cut_towards(m, cc.stroke, cystotome_rest, cc.cut, cc.log).made;
+            if (pulled) tear::tear_step(m, cc.flap, cc.tear_state, pull, cc.tear, cc.cut, cc.log);
+            std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
+            const uint32_t after = p.slots.size();
+            p.x.resize(after), p.y.resize(after), p.z.resize(after);
+            for (const cut::ParticleOrigin& o : cc.log.origins) {
+              double x = 0, y = 0, z = 0;
+              for (int k = 0; k < 3; ++k) {
+                if (o.from[k] == kInvalidIndex) continue;
+                x += o.weight[k] * p.x[o.from[k]], y += o.weight[k] * p.y[o.from[k]], z += o.weight[k] * p.z[o.from[k]];
+              }
+              p.x[o.particle] = static_cast<float>(x), p.y[o.particle] = static_cast<float>(y),
+              p.z[o.particle] = static_cast<float>(z);
             }
             const double edit_ms = elapsed_ms(t0);
             cc.edit_ms_total += edit_ms;

@@ -5,6 +5,14 @@
 // (systems/tear) from the tip of the last cystotome cut, with the force the forceps exerts on the
 // flap — the pull of the grasped particle's springs, reversed — as seed 000's f_t.
 //
+// The cut runs in the capsule's rest shape (material coordinates): the membrane under the forceps
+// is stretched, sheared and folded, and a tear walked over the deformed surface meets its own
+// flap. So for the edits the particle positions are swapped (O(1), vector swaps) with a mirror of
+// the rest positions; the cystotome's contact point is located on the deformed capsule and carried
+// to the rest shape by its barycentric weights; the tear direction is the flap force's. After the
+// edits the positions are swapped back and each new particle is placed by replaying its origin
+// (cut::ParticleOrigin) on the current positions.
+//
 // Runs in the topology phase, before the dynamics: it edits the capsule's tables through a
 // CutMesh (local edits), then, if anything changed, brings the physics up to date — the spring
 // table is compacted and sorted again, the spring graph, blocks, glue and scratch arrays are
@@ -33,6 +41,7 @@ struct CapsuleCutting {
   cut::CutPath stroke;           // the cystotome's current path
   cut::CutPath flap;             // the path the tear continues (the last stroke with a tip)
   tear::TearState tear_state;
+  std::vector<float> rest_x, rest_y, rest_z;  // per particle: the rest shape, swapped in for the edits
   cut::EditLog log;              // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics rebuild after changes

@@ -44,6 +44,7 @@
 #include <cstdint>
 
 #include "systems/cut/membrane_edit.hpp"
+#include "systems/cut/vertex_insertion.hpp"
 #include "systems/cut/progressive_cut.hpp"
 
 namespace phaco::cut {
