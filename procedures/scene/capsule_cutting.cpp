@@ -154,7 +154,12 @@ SystemDesc capsule_cut_system(Scene& scene) {
               for (Entity tool : scene.tools) {
                 const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
                 if (!g || !g->capsule.holding() || !p.slots.alive(g->capsule.particle)) continue;
-                pull = flap_force(m, g->capsule.particle);
+                // The flap is a strip under tension between the forceps and the tear's tip: the
+                // pull reaches the tip along the strip (magnitude: the held particle's springs).
+                // Closer than min_lever_mm the strip has no direction to speak of: no tear.
+                const Vec3 along = scene.world.at<ToolState>(tool).pos - cut::particle_position(p, cc.flap.tip);
+                if (along.norm() < cc.min_lever_mm) break;
+                pull = flap_force(m, g->capsule.particle).norm() * along.normalized();
                 pulled = true;
                 break;
               }

@@ -2,8 +2,9 @@
 // Cutting and tearing the anterior capsule in the running scene (issue 4): the cystotome cuts
 // where its tip touches the capsule (seed 000 §5.2 progressive cut: a cut point per frame while
 // in contact, the path ends when the tip leaves), and a forceps holding the flap tears it
-// (systems/tear) from the tip of the last cystotome cut, with the force the forceps exerts on the
-// flap — the pull of the grasped particle's springs, reversed — as seed 000's f_t.
+// (systems/tear) from the tip of the last cystotome cut. Seed 000's f_t: the flap is a strip under
+// tension between the forceps and the tear's tip, so the pull reaches the tip along the strip — its
+// direction from the tip to the forceps, its magnitude the pull of the held particle's springs.
 //
 // The cut runs in the capsule's rest shape (material coordinates): the membrane under the forceps
 // is stretched, sheared and folded, and a tear walked over the deformed surface meets its own
@@ -38,6 +39,7 @@ struct CapsuleCutting {
   tear::TearSettings tear;
   double contact_mm = 0.05;      // cystotome tip this close to the capsule cuts,
   double penetration_mm = 0.5;   // and so does one pressed up to this far through it
+  double min_lever_mm = 0.3;     // forceps this close to the tear's tip do not tear
   cut::CutPath stroke;           // the cystotome's current path
   cut::CutPath flap;             // the path the tear continues (the last stroke with a tip)
   tear::TearState tear_state;

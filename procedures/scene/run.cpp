@@ -98,6 +98,21 @@ std::string summary_text(const RunReport& r) {
   out += "elements:";
   for (const auto& [k, v] : r.elements) out += " " + k + "=" + std::to_string(v);
   for (const auto& [body, ph] : r.physics.items()) {
+    if (body == "capsule_cutting") {
+      std::snprintf(line, sizeof line,
+                    "\ncapsule cutting: %llu cut segments, %llu tear steps (%llu advanced, rule %s), %llu run-out "
+                    "warnings, %llu radial tear-outs, opening %s",
+                    ph.value("cut_segments", 0ull), ph.value("tear_steps", 0ull), ph.value("tear_advances", 0ull),
+                    ph.value("tear_rule", std::string("?")).c_str(), ph.value("runout_warnings", 0ull),
+                    ph.value("radial_tearouts", 0ull), ph.value("opening_complete", false) ? "closed" : "not closed");
+      out += line;
+      if (ph.value("opening_complete", false)) {
+        std::snprintf(line, sizeof line, " (diameter %.2f mm, circularity %.3f)", ph.value("opening_diameter_mm", 0.0),
+                      ph.value("opening_circularity", 0.0));
+        out += line;
+      }
+      continue;
+    }
     out += "\n" + body + ": " + ph.value("integrator", std::string("?")) + ", active set mean " +
            std::to_string(static_cast<long long>(ph.value("active_particles_mean", 0.0))) + " / max " +
            std::to_string(ph.value("active_particles_max", 0u)) + " particles, " +

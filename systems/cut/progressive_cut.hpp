@@ -48,7 +48,7 @@ struct CutSettings {
   bool remesh = true;                  // Fig. 5a merging along the path
   double remesh_max_turn_deg = 10.0;   // "almost co-linear" cut edges
   uint32_t max_steps_per_segment = 4096;
-  uint32_t own_lip_hops = 4;           // a boundary this close to the tip along free edges is the
+  uint32_t own_lip_hops = 12;          // a boundary this close to the tip along free edges is the
                                        // cut's own lip, not a boundary to cut through to
 };
 

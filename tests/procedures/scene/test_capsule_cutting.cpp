@@ -1,6 +1,7 @@
 // Cutting and tearing in the running scene (procedures/scene/capsule_cutting): the demo's
-// cystotome cuts the capsule, the forceps tear the flap; the membrane keeps its invariants, the
-// result does not depend on the thread count, and the tear's events are recorded in order.
+// cystotome cuts the capsule, the forceps tear the flap round until the disc comes free; the
+// membrane keeps its invariants, the result does not depend on the thread count, and the tear's
+// events are recorded in order.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -61,7 +62,13 @@ TEST(CapsuleCutting, TheDemoCutsAndTearsTheCapsuleAndKeepsItSound) {
     if (e.kind == tear::TearEvent::RunoutWarning) warned = true;
     if (e.kind == tear::TearEvent::RadialTearout) EXPECT_TRUE(warned) << "tear-out without a warning first";
   }
+  // The demo's forceps close the circle: the disc comes free, round and about the target size.
   const nlohmann::json j = capsule_cutting_summary(*scene);
+  ASSERT_TRUE(j["opening_complete"].get<bool>());
+  EXPECT_NEAR(j["opening_diameter_mm"].get<double>(), 5.0, 0.4);
+  EXPECT_GT(j["opening_circularity"].get<double>(), 0.85);
+  EXPECT_LT(j["opening_centering_mm"].get<double>(), 0.4);
+  EXPECT_EQ(j["radial_tearouts"].get<uint64_t>(), 0u);
   EXPECT_EQ(j["cut_segments"].get<uint64_t>(), cc->cut_segments);
 }
 
