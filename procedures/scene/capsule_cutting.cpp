@@ -121,10 +121,41 @@ SystemDesc capsule_cut_system(Scene& scene) {
             Triangles& tr = scene.world.at<Triangles>(capsule);
             CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
             CapsuleCutting& cc = scene.world.at<CapsuleCutting>(capsule);
-            cc.log.clear();
             ++cc.frames;
             cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
             const auto t0 = std::chrono::steady_clock::now();
+            // Forceps: a temporary vertex where they close, removed once they have let go. These
+            // edits are made where the forceps are, on the deformed capsule.
+            cut::EditLog grasp_log;
+            cc.forceps.resize(scene.tools.size());
+            for (size_t k = 0; k < scene.tools.size(); ++k) {
+              const ToolGrasp* g = scene.world.get<ToolGrasp>(scene.tools[k]);
+              if (!g) continue;
+              cut::GraspPoint& held = cc.forceps[k];
+              if (held.held() && !g->capsule.holding()) {  // systems/grasp let go last frame
+                const cut::ReleaseReport r = cut::release(m, held, grasp_log);
+                cc.temporary_removed += r.removed_temporary;
+                cc.temporary_kept += r.kept_temporary;
+                held = {};
+              }
+              const ToolState& st = scene.world.at<ToolState>(scene.tools[k]);
+              if (held.held() || g->capsule.holding() || g->capsule.closed || st.grip < cp.grasp.close_at) continue;
+              // Closing this frame: grasp the surface under the tip if it is within reach.
+              const cut::CutPoint c =
+                  cut::locate_cut_point(p, tr, cc.topology.adjacency, cc.stroke.hint_triangle, st.pos, cc.cut.snap);
+              if (c.distance_mm > cp.grasp.radius_mm) continue;
+              held = cut::grasp_at(m, c, cc.cut, grasp_log);
+              if (held.held() && !held.temporary) held = {};  // an existing vertex: nothing to undo
+              cc.temporary_vertices += held.temporary;
+            }
+            for (uint32_t v : grasp_log.new_particles) {  // keep the rest mirror in step
+              if (cc.rest_x.size() <= v) cc.rest_x.resize(v + 1), cc.rest_y.resize(v + 1), cc.rest_z.resize(v + 1);
+              const Vec3 r = cut::rest_position(cc.topology, v);
+              cc.rest_x[v] = float(r.x()), cc.rest_y[v] = float(r.y()), cc.rest_z[v] = float(r.z());
+            }
+            cc.log = grasp_log;
+            cc.log.origins.clear();  // placed already: not to be replayed after the rest-shape edits
+
             // What the tools do, seen on the deformed capsule.
             bool cystotome_cutting = false;
             Vec3 cystotome_rest = Vec3::Zero();
@@ -166,6 +197,10 @@ SystemDesc capsule_cut_system(Scene& scene) {
             }
             if (!cystotome_cutting && !pulled) {
               cc.edit_ms_total += elapsed_ms(t0);
+              if (!cc.log.touched_triangles.empty()) {
+                refresh_physics(m, cp, cc.log);
+                ++cc.topology_changes;
+              }
               return;
             }
             // The edits, in the rest shape.
@@ -221,6 +256,9 @@ nlohmann::json capsule_cutting_summary(Scene& scene) {
                       {"physics_refresh_ms_mean",
                        cc->topology_changes ? cc->refresh_ms_total / double(cc->topology_changes) : 0.0},
                       {"physics_refresh_ms_max", cc->refresh_ms_max},
+                      {"temporary_grasp_vertices", cc->temporary_vertices},
+                      {"temporary_grasp_vertices_removed", cc->temporary_removed},
+                      {"temporary_grasp_vertices_kept", cc->temporary_kept},
                       {"opening_complete", o.complete}};
   if (o.complete) {
     j["opening_diameter_mm"] = o.diameter_mm;

@@ -20,11 +20,17 @@
 // rebuilt for the new particle count (a pass over the whole capsule: see docs/cutting_and_tearing.md
 // for its cost). Remeshing is off in the scene so that no particle is removed.
 //
+// Forceps grasp inside a triangle or on an edge through a temporary vertex (seed 000 Fig. 9,
+// systems/cut/grasp_point): when a forceps closes near the capsule, the point under its tip becomes
+// a vertex (in the deformed shape, where the forceps are), which systems/grasp then holds as the
+// nearest particle; once the forceps have let go it is removed again if nothing has cut through it.
+//
 // Methods (scenario `methods`): capsule.cutting on | off (default on); capsule.tear_rule
 // flap_force | most_stressed_spring (default flap_force).
 #include <nlohmann/json.hpp>
 
 #include "engine/schedule/system.hpp"
+#include "systems/cut/grasp_point.hpp"
 #include "systems/cut/progressive_cut.hpp"
 #include "systems/tear/tear.hpp"
 
@@ -44,6 +50,8 @@ struct CapsuleCutting {
   cut::CutPath flap;             // the path the tear continues (the last stroke with a tip)
   tear::TearState tear_state;
   std::vector<float> rest_x, rest_y, rest_z;  // per particle: the rest shape, swapped in for the edits
+  std::vector<cut::GraspPoint> forceps;       // per scene tool: the temporary grasp vertex it holds
+  uint64_t temporary_vertices = 0, temporary_removed = 0, temporary_kept = 0;
   cut::EditLog log;              // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics rebuild after changes
