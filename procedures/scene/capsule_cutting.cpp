@@ -69,16 +69,9 @@ void refresh_physics(cut::CutMesh& m, CapsulePhysics& cp, const cut::EditLog& lo
 }  // namespace
 
 bool add_capsule_cutting(Scene& scene) {
-  const auto choice = [&](const std::string& key, const std::string& fallback,
-                          std::initializer_list<std::string_view> allowed) {
-    const auto it = scene.scenario.methods.find(key);
-    if (it == scene.scenario.methods.end()) return fallback;
-    for (std::string_view a : allowed)
-      if (it->second == a) return it->second;
-    throw InputError(scene.scenario.source + ": methods[\"" + key + "\"]: unknown choice '" + it->second + "'");
-  };
-  if (choice("capsule.cutting", "on", {"on", "off"}) == "off") return false;
-  const std::string rule = choice("capsule.tear_rule", "flap_force", {"flap_force", "most_stressed_spring"});
+
+  if (method_choice(scene, "capsule.cutting", "on", {"on", "off"}) == "off") return false;
+  const std::string rule = method_choice(scene, "capsule.tear_rule", "flap_force", {"flap_force", "most_stressed_spring"});
 
   const Entity capsule = *scene.body(BodyPart::Capsule);
   Particles& p = scene.world.at<Particles>(capsule);

@@ -19,6 +19,9 @@ constexpr std::array<std::string_view, 7> kCapsuleMethods = {
     "capsule.integrator", "capsule.spring_law", "capsule.stiffness", "capsule.pretension", "capsule.active_set",
     "capsule.cutting",    "capsule.tear_rule"};
 
+
+}  // namespace
+
 std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback,
                           std::initializer_list<std::string_view> allowed) {
   const auto it = scene.scenario.methods.find(key);
@@ -31,8 +34,6 @@ std::string method_choice(const Scene& scene, const std::string& key, const std:
   throw InputError(scene.scenario.source + ": methods[\"" + key + "\"]: unknown choice '" + it->second +
                    "'; expected one of: " + names);
 }
-
-}  // namespace
 
 bool is_capsule_method(const std::string& key) {
   for (std::string_view k : kCapsuleMethods) {

@@ -15,6 +15,10 @@
 //   capsule.active_set   on | off                               (default on)
 //   capsule.cutting      on | off, capsule.tear_rule flap_force | most_stressed_spring
 //                        (procedures/scene/capsule_cutting.hpp)
+#include <initializer_list>
+#include <string>
+#include <string_view>
+
 #include <nlohmann/json.hpp>
 
 #include "components/dynamics.hpp"
@@ -57,6 +61,11 @@ struct CapsulePhysics {
 struct ToolGrasp {
   grasp::GraspState capsule;
 };
+
+// The scenario's choice for a `methods` key, `fallback` if absent; InputError naming the key and
+// the allowed choices otherwise.
+std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback,
+                          std::initializer_list<std::string_view> allowed);
 
 // Known `methods` keys for the capsule; every other "capsule.*" key is rejected by the scene.
 bool is_capsule_method(const std::string& key);

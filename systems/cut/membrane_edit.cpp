@@ -240,6 +240,12 @@ void triangles_on_edge(const CutMesh& m, uint32_t a, uint32_t b, std::vector<uin
     if (corner_slot(m.triangles, t, b) >= 0) out.push_back(t);
 }
 
+bool joined_edge(const CutMesh& m, uint32_t a, uint32_t b) {
+  std::vector<uint32_t> tris;
+  triangles_on_edge(m, a, b, tris);
+  return tris.size() == 2 && link_across(m, tris[0], a, b) == tris[1];
+}
+
 bool on_boundary(const CutMesh& m, uint32_t v) {
   const uint32_t h = m.topology.vertex_triangle[v];
   if (!m.triangles.slots.alive(h)) return false;

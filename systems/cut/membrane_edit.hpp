@@ -93,6 +93,10 @@ MembraneTopology build_topology(const Particles& particles, const Triangles& tri
 // Alive triangles holding both a and b (one or two; more only on a broken mesh), sorted.
 void triangles_on_edge(const CutMesh& m, uint32_t a, uint32_t b, std::vector<uint32_t>& out);
 
+// True if (a, b) is an edge whose two triangles are still neighbours across it: it can be cut or
+// torn along (not the rim, not an opened cut, not a slit).
+bool joined_edge(const CutMesh& m, uint32_t a, uint32_t b);
+
 // True if v lies on the membrane's boundary (rim or an opened cut): its fan is open.
 bool on_boundary(const CutMesh& m, uint32_t v);
 

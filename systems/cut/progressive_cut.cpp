@@ -120,21 +120,6 @@ uint32_t realise(CutMesh& m, const Placement& p, EditLog& log) {
   }
 }
 
-// Is (u, v) an edge whose two triangles are still neighbours (so it can be cut)?
-bool cuttable(const CutMesh& m, uint32_t u, uint32_t v) {
-  std::vector<uint32_t> tris;
-  triangles_on_edge(m, u, v, tris);
-  if (tris.size() != 2) return false;
-  const int k = [&] {
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t c0 = corner(m.triangles, tris[0], e), c1 = corner(m.triangles, tris[0], (e + 1) % 3);
-      if ((c0 == u && c1 == v) || (c0 == v && c1 == u)) return e;
-    }
-    return -1;
-  }();
-  return k >= 0 && m.topology.adjacency.neighbour[tris[0]][k] == tris[1];
-}
-
 // Is v within `hops` free (boundary) edges of `tip`?
 bool own_lip(const CutMesh& m, uint32_t tip, uint32_t v, uint32_t hops) {
   std::vector<uint32_t> frontier{tip}, seen{tip}, next, fan;
@@ -274,7 +259,7 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     } else if (p.kind == CutPoint::Edge) {
       std::vector<uint32_t> tris;
       triangles_on_edge(m, p.a, p.b, tris);
-      boundary = tris.size() != 2 || !cuttable(m, p.a, p.b);
+      boundary = tris.size() != 2 || !joined_edge(m, p.a, p.b);
     }
     // A boundary a few edges from the tip along the free edges is this cut's own lip: stepping
     // onto it is going back or sideways into the incision, not cutting through (a tool lifting
@@ -285,7 +270,7 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
       break;
     }
     const uint32_t q = realise(m, p, log);
-    if (!cuttable(m, tip, q)) {  // the way runs along the rim or an opened cut
+    if (!joined_edge(m, tip, q)) {  // the way runs along the rim or an opened cut
       r.reached_boundary = boundary;
       if (!boundary) r.stalled = true;
       break;

@@ -16,18 +16,6 @@ Vec3 radial(const Vec3& p) {
   return n > 1e-12 ? Vec3(r / n) : Vec3::Zero();
 }
 
-// Is (u, v) an edge whose two triangles are still joined (so the tear can run along it)?
-bool joined(const cut::CutMesh& m, uint32_t u, uint32_t v) {
-  std::vector<uint32_t> tris;
-  cut::triangles_on_edge(m, u, v, tris);
-  if (tris.size() != 2) return false;
-  for (int k = 0; k < 3; ++k) {
-    const uint32_t a = cut::corner(m.triangles, tris[0], k), b = cut::corner(m.triangles, tris[0], (k + 1) % 3);
-    if ((a == u && b == v) || (a == v && b == u)) return m.topology.adjacency.neighbour[tris[0]][k] == tris[1];
-  }
-  return false;
-}
-
 }  // namespace
 
 std::string_view to_string(TearRule r) { return r == TearRule::FlapForce ? "flap_force" : "most_stressed_spring"; }
@@ -99,7 +87,7 @@ uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const Tea
   for (uint32_t t : fan) {
     for (int k = 0; k < 3; ++k) {
       const uint32_t n = cut::corner(m.triangles, t, k);
-      if (n == tip || !joined(m, tip, n)) continue;
+      if (n == tip || !cut::joined_edge(m, tip, n)) continue;
       const auto it = m.topology.spring_of_edge.find(cut::edge_key(tip, n));
       if (it == m.topology.spring_of_edge.end()) continue;
       const double rest = m.springs.rest_length[it->second];
