@@ -95,27 +95,13 @@ std::vector<Vec3> tool_polyline(const SurfaceCutter& s) {
   return out;
 }
 
-// The blade has stopped, so no later sample will come for a path whose tip waits short of its
-// last end (the cutter refused every placement there). It gets that end again, first with the
-// finishing quality bound; if it still waits, with a vertex snap just under its gap, so the end
-// goes to a vertex nearer the blade's end than the tip is, if there is one in the way (the cut may
-// then pass the end by less than it would have fallen short). True if the mesh changed.
+// The blade has stopped: each waiting end gets its last sample again (cut::finish_cut). True if
+// the mesh changed.
 bool finish(cut::CutMesh& m, SurfaceCutter& s, const cut::CutSettings& settings,
             double min_angle_deg, cut::EditLog& log, uint32_t& segments) {
   bool made = false;
   for (SidePath& p : s.side) {
-    for (int attempt = 0; attempt < 2; ++attempt) {
-      const cut::CutPath& path = p.path;
-      if (path.tip == kInvalidIndex || path.reached_boundary || path.tool_points.size() < 2) break;
-      const Vec3 end = path.tool_points.back();
-      const double gap = (cut::particle_position(m.particles, path.tip) - end).norm();
-      if (gap <= settings.snap.vertex_snap_mm) break;
-      cut::CutSettings relaxed = settings;
-      relaxed.min_angle_deg = std::min(settings.min_angle_deg, min_angle_deg);
-      if (attempt == 1) relaxed.snap.vertex_snap_mm = gap * (1.0 - 1e-9);
-      const cut::SegmentReport r = cut::cut_towards(m, p.path, end, relaxed, log);
-      if (r.made) ++segments, made = true;
-    }
+    if (cut::finish_cut(m, p.path, settings, min_angle_deg, log)) ++segments, made = true;
   }
   return made;
 }

@@ -172,6 +172,24 @@ void end_cut(CutPath& path) {
   path.direction = Vec3::Zero();
 }
 
+bool finish_cut(CutMesh& m, CutPath& path, const CutSettings& settings, double min_angle_deg, EditLog& log) {
+  bool made = false;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    if (path.tip == kInvalidIndex || !m.particles.slots.alive(path.tip) || path.reached_boundary ||
+        path.tool_points.size() < 2)
+      break;
+    const Vec3 end = path.tool_points.back();
+    const double gap = (pos(m, path.tip) - end).norm();
+    if (gap <= settings.snap.vertex_snap_mm) break;
+    CutSettings relaxed = settings;
+    relaxed.min_angle_deg = std::min(settings.min_angle_deg, min_angle_deg);
+    if (attempt == 1) relaxed.snap.vertex_snap_mm = gap * (1.0 - 1e-9);
+    path.tool_points.pop_back();  // cut_towards records the sample again
+    made = cut_towards(m, path, end, relaxed, log).made || made;
+  }
+  return made;
+}
+
 SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, const CutSettings& s, EditLog& log) {
   SegmentReport r;
   if (!tool_point.allFinite()) throw std::invalid_argument("cut_towards: the tool point is not finite");

@@ -85,4 +85,12 @@ SegmentReport cut_towards(CutMesh& mesh, CutPath& path, const Vec3& tool_point, 
 // The tool left the mesh: the next sample starts a new path (a new initial cut).
 void end_cut(CutPath& path);
 
+// The tool has stopped or is leaving, so no later sample will come for a path whose tip waits short
+// of its last sample (every placement there was refused by the quality snap). The path gets that
+// sample again, first with min_angle_deg as the quality bound (≥ 1°, the invariants' bound);
+// if it still waits, with a vertex snap just under its gap, so the end goes to a vertex nearer the
+// sample than the tip is, if one is in the way (the cut may then pass the sample by less than it
+// would have fallen short). Returns true if the mesh changed; call before end_cut.
+bool finish_cut(CutMesh& mesh, CutPath& path, const CutSettings& settings, double min_angle_deg, EditLog& log);
+
 }  // namespace phaco::cut
