@@ -75,6 +75,12 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
         out.perimeter_mm += std::hypot(m.particles.x[u] - m.particles.x[w], m.particles.y[u] - m.particles.y[w]);
     }
   }
+  // A lip folded over the opening hides some of its edges from that count: the perimeter is never
+  // taken shorter than the opening's own contour simplified to within a pixel (which, if anything,
+  // cuts corners).
+  std::vector<cv::Point> simplified;
+  cv::approxPolyDP(c, simplified, 1.0, true);
+  out.perimeter_mm = std::max(out.perimeter_mm, cv::arcLength(simplified, true) * pixel_mm);
   out.circularity = out.perimeter_mm > 0 ? 4.0 * 3.14159265358979323846 * out.area_mm2 /
                                                (out.perimeter_mm * out.perimeter_mm)
                                          : 0.0;

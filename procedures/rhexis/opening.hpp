@@ -5,7 +5,9 @@
 //
 // From it: area, equivalent diameter 2·√(A/π), the fitted ellipse's mean diameter and axis ratio
 // (cv::fitEllipse), circularity 4πA/P² with P the length of the free capsule edges bordering the
-// opening (a pixel contour would overstate P by its staircase), and centring (the opening's
+// opening (a raw pixel contour would overstate P by its staircase) but never less than the
+// opening's contour simplified to within a pixel (a lip folded over the opening hides edges from
+// the count), and centring (the opening's
 // centroid from the optical axis). An opening that is not closed (the disc still hangs on) has
 // no uncovered region: complete = false.
 //

@@ -66,6 +66,15 @@ void refresh_physics(cut::CutMesh& m, CapsulePhysics& cp, const cut::EditLog& lo
   cp.state.implicit.invalidate();
 }
 
+// The particles this frame's edits made become sources (seeds of the active set).
+void add_sources(CapsuleCutting& cc, const Particles& p, uint64_t frame) {
+  for (uint32_t v : cc.log.new_particles) {
+    if (!p.slots.alive(v)) continue;
+    cc.sources.push_back(v);
+    cc.source_frame.push_back(frame);
+  }
+}
+
 }  // namespace
 
 bool add_capsule_cutting(Scene& scene) {
@@ -109,12 +118,19 @@ SystemDesc capsule_cut_system(Scene& scene) {
           .phase = Phase::Topology,
           .reads = {"tools.pose", "tools.grasp"},
           .writes = {"capsule.particles", "capsule.triangles", "capsule.physics"},
-          .run = [&scene, capsule](const FrameContext&) {
+          .run = [&scene, capsule](const FrameContext& ctx) {
             Particles& p = scene.world.at<Particles>(capsule);
             Triangles& tr = scene.world.at<Triangles>(capsule);
             CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
             CapsuleCutting& cc = scene.world.at<CapsuleCutting>(capsule);
             ++cc.frames;
+            // Lips older than source_frames are left to the active set's wake rules.
+            size_t keep = 0;
+            for (size_t i = 0; i < cc.sources.size(); ++i) {
+              if (cc.source_frame[i] + cc.source_frames <= ctx.frame) continue;
+              cc.sources[keep] = cc.sources[i], cc.source_frame[keep] = cc.source_frame[i], ++keep;
+            }
+            cc.sources.resize(keep), cc.source_frame.resize(keep);
             cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
             const auto t0 = std::chrono::steady_clock::now();
             // Forceps: a temporary vertex where they close, removed once they have let go. These
@@ -191,6 +207,7 @@ SystemDesc capsule_cut_system(Scene& scene) {
             if (!cystotome_cutting && !pulled) {
               cc.edit_ms_total += elapsed_ms(t0);
               if (!cc.log.touched_triangles.empty()) {
+                add_sources(cc, p, ctx.frame);
                 refresh_physics(m, cp, cc.log);
                 ++cc.topology_changes;
               }
@@ -217,6 +234,7 @@ SystemDesc capsule_cut_system(Scene& scene) {
             cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);
             if (cc.log.touched_triangles.empty() && cc.log.new_particles.empty() && cc.log.opened_edges == 0) return;
             const auto t1 = std::chrono::steady_clock::now();
+            add_sources(cc, p, ctx.frame);
             refresh_physics(m, cp, cc.log);
             const double refresh_ms = elapsed_ms(t1);
             cc.refresh_ms_total += refresh_ms;

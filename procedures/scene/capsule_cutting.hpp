@@ -51,6 +51,11 @@ struct CapsuleCutting {
   tear::TearState tear_state;
   std::vector<float> rest_x, rest_y, rest_z;  // per particle: the rest shape, swapped in for the edits
   std::vector<cut::GraspPoint> forceps;       // per scene tool: the temporary grasp vertex it holds
+  // The cut's fresh lips (particles the cut made in the last source_frames frames): seeds of the
+  // capsule's active set, so the dynamics open the cut wherever it is.
+  std::vector<uint32_t> sources;
+  std::vector<uint64_t> source_frame;
+  uint64_t source_frames = 15;
   uint64_t temporary_vertices = 0, temporary_removed = 0, temporary_kept = 0;
   cut::EditLog log;              // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;

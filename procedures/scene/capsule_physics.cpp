@@ -7,6 +7,7 @@
 #include "components/tool.hpp"
 #include "components/triangles.hpp"
 #include "engine/core/error.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/springs/springs.hpp"
 #include "systems/topology_check/topology_check.hpp"
@@ -121,8 +122,11 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
             }
 
             // Seeds of the active set: what the forceps hold this frame.
-            std::array<uint32_t, 2> seeds{};
-            uint32_t seed_count = 0;
+            // Seeds of the active set: what the forceps hold this frame, and the cut's fresh lips (seed
+            // 000 §5.2: "the vertices on the cut path ... serving as the starting points of force
+            // propagation"), so a cut far from the forceps still opens.
+            std::vector<uint32_t>& seeds = cp.seeds;
+            seeds.clear();
             for (Entity tool : scene.tools) {
               ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
               if (!g) continue;
@@ -131,7 +135,7 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
               cp.grasps += ev.grasped;
               cp.releases += ev.released;
               cp.missed_grasps += ev.missed;
-              if (g->capsule.holding() && seed_count < seeds.size()) seeds[seed_count++] = g->capsule.particle;
+              if (g->capsule.holding()) seeds.push_back(g->capsule.particle);
             }
 
             deform::Membrane m{p, cp.springs, cp.blocks, cp.forces, cp.dynamics, &cp.glue, &cp.environment};
@@ -143,7 +147,11 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
               wake.law = cp.dynamics.law;
               wake.motion_threshold_mm = cp.wake_motion_mm;
               wake.force_threshold_mn = cp.wake_force_mn;
-              active_nodes::update_active_set(cp.graph, std::span<const uint32_t>(seeds.data(), seed_count),
+              if (const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(capsule)) {
+                for (uint32_t v : cc->sources)
+                  if (p.slots.alive(v)) seeds.push_back(v);
+              }
+              active_nodes::update_active_set(cp.graph, std::span<const uint32_t>(seeds.data(), seeds.size()),
                                               cp.active_hops, wake, cp.active);
               for (uint32_t i : cp.active.fell_asleep) p.vx[i] = p.vy[i] = p.vz[i] = 0.0f;
               if (cp.active.particles.empty()) return;  // the whole capsule sleeps: nothing to integrate

@@ -49,6 +49,7 @@ struct CapsulePhysics {
   double wake_motion_mm = 1e-3;  // a neighbour moving more than this in a step wakes a sleeper
   double wake_force_mn = 1e-2;   // so does an unbalanced force above this
   grasp::GraspSettings grasp;
+  std::vector<uint32_t> seeds;  // this frame's active-set seeds (scratch)
 
   // Over the run, for the report.
   uint64_t frames_stepped = 0;
