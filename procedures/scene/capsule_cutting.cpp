@@ -75,6 +75,118 @@ void add_sources(CapsuleCutting& cc, const Particles& p, uint64_t frame) {
   }
 }
 
+// Lips older than source_frames are left to the active set's wake rules.
+void prune_sources(CapsuleCutting& cc, uint64_t frame) {
+  size_t keep = 0;
+  for (size_t i = 0; i < cc.sources.size(); ++i) {
+    if (cc.source_frame[i] + cc.source_frames <= frame) continue;
+    cc.sources[keep] = cc.sources[i], cc.source_frame[keep] = cc.source_frame[i], ++keep;
+  }
+  cc.sources.resize(keep), cc.source_frame.resize(keep);
+}
+
+// Forceps: a temporary vertex under the tip the frame they close (seed 000 Fig. 9), removed the
+// frame after systems/grasp has let go. Made on the deformed capsule; new particles are placed
+// already, so their origins are not replayed, and the rest mirror gets their rest positions.
+void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, const CapsulePhysics& cp) {
+  cc.forceps.resize(scene.tools.size());
+  for (size_t k = 0; k < scene.tools.size(); ++k) {
+    const ToolGrasp* g = scene.world.get<ToolGrasp>(scene.tools[k]);
+    if (!g) continue;
+    cut::GraspPoint& held = cc.forceps[k];
+    if (held.held() && !g->capsule.holding()) {
+      const cut::ReleaseReport r = cut::release(m, held, cc.log);
+      cc.temporary_removed += r.removed_temporary;
+      cc.temporary_kept += r.kept_temporary;
+      held = {};
+    }
+    const ToolState& st = scene.world.at<ToolState>(scene.tools[k]);
+    if (held.held() || g->capsule.holding() || g->capsule.closed || st.grip < cp.grasp.close_at) continue;
+    const cut::CutPoint c =
+        cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency, cc.contact_hint, st.pos, cc.cut.snap);
+    cc.contact_hint = c.triangle;
+    if (c.distance_mm > cp.grasp.radius_mm) continue;
+    held = cut::grasp_at(m, c, cc.cut, cc.log);
+    if (held.held() && !held.temporary) held = {};  // an existing vertex: nothing to undo
+    cc.temporary_vertices += held.temporary;
+  }
+  for (uint32_t v : cc.log.new_particles) {
+    if (cc.rest_x.size() <= v) cc.rest_x.resize(v + 1), cc.rest_y.resize(v + 1), cc.rest_z.resize(v + 1);
+    const Vec3 r = cut::rest_position(cc.topology, v);
+    cc.rest_x[v] = float(r.x()), cc.rest_y[v] = float(r.y()), cc.rest_z[v] = float(r.z());
+  }
+  cc.log.origins.clear();
+}
+
+// The cystotome cuts where its tip touches the capsule or is pressed through it; `rest_point` is
+// that point carried to the rest shape by its barycentric weights. When the tip leaves, the stroke
+// ends and becomes the flap the tear continues.
+bool cystotome_contact(Scene& scene, const cut::CutMesh& m, CapsuleCutting& cc, Vec3& rest_point) {
+  bool cutting = false;
+  for (Entity tool : scene.tools) {
+    if (scene.world.at<Tool>(tool).kind != ToolKind::Cystotome) continue;
+    const Vec3 tip = scene.world.at<ToolState>(tool).pos;
+    const cut::CutPoint c =
+        cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency, cc.contact_hint, tip, cc.cut.snap);
+    cc.contact_hint = c.triangle;
+    const uint32_t t = c.triangle;
+    const Vec3 a = cut::particle_position(m.particles, m.triangles.a[t]);
+    const Vec3 normal = (cut::particle_position(m.particles, m.triangles.b[t]) - a)
+                            .cross(cut::particle_position(m.particles, m.triangles.c[t]) - a);
+    const bool through = (tip - c.position).dot(normal) < 0.0 && c.distance_mm <= cc.penetration_mm;
+    if (c.distance_mm <= cc.contact_mm || through) {
+      cutting = true;
+      rest_point = Vec3::Zero();
+      for (int k = 0; k < 3; ++k)
+        rest_point += c.bary[k] * cut::rest_position(cc.topology, cut::corner(m.triangles, t, k));
+    } else if (cc.stroke.started) {
+      if (cc.stroke.tip != kInvalidIndex) cc.flap = cc.stroke, cc.tear_state = {};
+      cc.stroke = {};
+    }
+  }
+  return cutting;
+}
+
+// Seed 000's f_t: the flap is a strip under tension between the forceps and the tear's tip, so the
+// pull reaches the tip along the strip, with the magnitude of the held particle's springs' pull.
+// Closer than min_lever_mm the strip has no direction to speak of: no tear.
+bool flap_pull(Scene& scene, const cut::CutMesh& m, const CapsuleCutting& cc, Vec3& pull) {
+  if (cc.flap.tip == kInvalidIndex || !m.particles.slots.alive(cc.flap.tip) || cc.tear_state.complete) return false;
+  for (Entity tool : scene.tools) {
+    const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
+    if (!g || !g->capsule.holding() || !m.particles.slots.alive(g->capsule.particle)) continue;
+    const Vec3 along = scene.world.at<ToolState>(tool).pos - cut::particle_position(m.particles, cc.flap.tip);
+    if (along.norm() < cc.min_lever_mm) return false;
+    pull = flap_force(m, g->capsule.particle).norm() * along.normalized();
+    return true;
+  }
+  return false;
+}
+
+// The cut and the tear run in the rest shape: positions swapped with the rest mirror (vector swaps),
+// the edits, the swap back, then each new particle placed on the deformed capsule by its origin.
+void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const Vec3& cut_at, bool pulling,
+                        const Vec3& pull) {
+  Particles& p = m.particles;
+  const size_t replay_from = cc.log.origins.size();
+  std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
+  if (cutting) cc.cut_segments += cut::cut_towards(m, cc.stroke, cut_at, cc.cut, cc.log).made;
+  if (pulling) tear::tear_step(m, cc.flap, cc.tear_state, pull, cc.tear, cc.cut, cc.log);
+  std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
+  const uint32_t n = p.slots.size();
+  p.x.resize(n), p.y.resize(n), p.z.resize(n);
+  for (size_t i = replay_from; i < cc.log.origins.size(); ++i) {
+    const cut::ParticleOrigin& o = cc.log.origins[i];
+    double x = 0, y = 0, z = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (o.from[k] == kInvalidIndex) continue;
+      x += o.weight[k] * p.x[o.from[k]], y += o.weight[k] * p.y[o.from[k]], z += o.weight[k] * p.z[o.from[k]];
+    }
+    p.x[o.particle] = static_cast<float>(x), p.y[o.particle] = static_cast<float>(y),
+    p.z[o.particle] = static_cast<float>(z);
+  }
+}
+
 }  // namespace
 
 bool add_capsule_cutting(Scene& scene) {
@@ -124,111 +236,15 @@ SystemDesc capsule_cut_system(Scene& scene) {
             CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
             CapsuleCutting& cc = scene.world.at<CapsuleCutting>(capsule);
             ++cc.frames;
-            // Lips older than source_frames are left to the active set's wake rules.
-            size_t keep = 0;
-            for (size_t i = 0; i < cc.sources.size(); ++i) {
-              if (cc.source_frame[i] + cc.source_frames <= ctx.frame) continue;
-              cc.sources[keep] = cc.sources[i], cc.source_frame[keep] = cc.source_frame[i], ++keep;
-            }
-            cc.sources.resize(keep), cc.source_frame.resize(keep);
+            prune_sources(cc, ctx.frame);
             cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
             const auto t0 = std::chrono::steady_clock::now();
-            // Forceps: a temporary vertex where they close, removed once they have let go. These
-            // edits are made where the forceps are, on the deformed capsule.
-            cut::EditLog grasp_log;
-            cc.forceps.resize(scene.tools.size());
-            for (size_t k = 0; k < scene.tools.size(); ++k) {
-              const ToolGrasp* g = scene.world.get<ToolGrasp>(scene.tools[k]);
-              if (!g) continue;
-              cut::GraspPoint& held = cc.forceps[k];
-              if (held.held() && !g->capsule.holding()) {  // systems/grasp let go last frame
-                const cut::ReleaseReport r = cut::release(m, held, grasp_log);
-                cc.temporary_removed += r.removed_temporary;
-                cc.temporary_kept += r.kept_temporary;
-                held = {};
-              }
-              const ToolState& st = scene.world.at<ToolState>(scene.tools[k]);
-              if (held.held() || g->capsule.holding() || g->capsule.closed || st.grip < cp.grasp.close_at) continue;
-              // Closing this frame: grasp the surface under the tip if it is within reach.
-              const cut::CutPoint c =
-                  cut::locate_cut_point(p, tr, cc.topology.adjacency, cc.stroke.hint_triangle, st.pos, cc.cut.snap);
-              if (c.distance_mm > cp.grasp.radius_mm) continue;
-              held = cut::grasp_at(m, c, cc.cut, grasp_log);
-              if (held.held() && !held.temporary) held = {};  // an existing vertex: nothing to undo
-              cc.temporary_vertices += held.temporary;
-            }
-            for (uint32_t v : grasp_log.new_particles) {  // keep the rest mirror in step
-              if (cc.rest_x.size() <= v) cc.rest_x.resize(v + 1), cc.rest_y.resize(v + 1), cc.rest_z.resize(v + 1);
-              const Vec3 r = cut::rest_position(cc.topology, v);
-              cc.rest_x[v] = float(r.x()), cc.rest_y[v] = float(r.y()), cc.rest_z[v] = float(r.z());
-            }
-            cc.log = grasp_log;
-            cc.log.origins.clear();  // placed already: not to be replayed after the rest-shape edits
-
-            // What the tools do, seen on the deformed capsule.
-            bool cystotome_cutting = false;
-            Vec3 cystotome_rest = Vec3::Zero();
-            for (Entity tool : scene.tools) {
-              if (scene.world.at<Tool>(tool).kind != ToolKind::Cystotome) continue;
-              const Vec3 tip = scene.world.at<ToolState>(tool).pos;
-              const cut::CutPoint c =
-                  cut::locate_cut_point(p, tr, cc.topology.adjacency, cc.stroke.hint_triangle, tip, cc.cut.snap);
-              // In contact: at the surface, or through it (the tip pressed into the capsule).
-              const uint32_t t = c.triangle;
-              const Vec3 a = cut::particle_position(p, tr.a[t]);
-              const Vec3 normal = (cut::particle_position(p, tr.b[t]) - a).cross(cut::particle_position(p, tr.c[t]) - a);
-              const bool through = (tip - c.position).dot(normal) < 0.0 && c.distance_mm <= cc.penetration_mm;
-              if (c.distance_mm <= cc.contact_mm || through) {
-                cystotome_cutting = true;
-                for (int k = 0; k < 3; ++k) cystotome_rest += c.bary[k] * cut::rest_position(cc.topology, cut::corner(tr, t, k));
-              } else if (cc.stroke.started) {  // the tip left the capsule: the stroke ends
-                if (cc.stroke.tip != kInvalidIndex) cc.flap = cc.stroke, cc.tear_state = {};
-                cc.stroke = {};
-              }
-            }
-            Vec3 pull = Vec3::Zero();
-            const bool tearing = !cystotome_cutting && cc.flap.tip != kInvalidIndex && p.slots.alive(cc.flap.tip) &&
-                                 !cc.tear_state.complete;
-            bool pulled = false;
-            if (tearing) {
-              for (Entity tool : scene.tools) {
-                const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
-                if (!g || !g->capsule.holding() || !p.slots.alive(g->capsule.particle)) continue;
-                // The flap is a strip under tension between the forceps and the tear's tip: the
-                // pull reaches the tip along the strip (magnitude: the held particle's springs).
-                // Closer than min_lever_mm the strip has no direction to speak of: no tear.
-                const Vec3 along = scene.world.at<ToolState>(tool).pos - cut::particle_position(p, cc.flap.tip);
-                if (along.norm() < cc.min_lever_mm) break;
-                pull = flap_force(m, g->capsule.particle).norm() * along.normalized();
-                pulled = true;
-                break;
-              }
-            }
-            if (!cystotome_cutting && !pulled) {
-              cc.edit_ms_total += elapsed_ms(t0);
-              if (!cc.log.touched_triangles.empty()) {
-                add_sources(cc, p, ctx.frame);
-                refresh_physics(m, cp, cc.log);
-                ++cc.topology_changes;
-              }
-              return;
-            }
-            // The edits, in the rest shape.
-            std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
-            if (cystotome_cutting) cc.cut_segments += cut::cut_towards(m, cc.stroke, cystotome_rest, cc.cut, cc.log).made;
-            if (pulled) tear::tear_step(m, cc.flap, cc.tear_state, pull, cc.tear, cc.cut, cc.log);
-            std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
-            const uint32_t after = p.slots.size();
-            p.x.resize(after), p.y.resize(after), p.z.resize(after);
-            for (const cut::ParticleOrigin& o : cc.log.origins) {
-              double x = 0, y = 0, z = 0;
-              for (int k = 0; k < 3; ++k) {
-                if (o.from[k] == kInvalidIndex) continue;
-                x += o.weight[k] * p.x[o.from[k]], y += o.weight[k] * p.y[o.from[k]], z += o.weight[k] * p.z[o.from[k]];
-              }
-              p.x[o.particle] = static_cast<float>(x), p.y[o.particle] = static_cast<float>(y),
-              p.z[o.particle] = static_cast<float>(z);
-            }
+            cc.log.clear();
+            forceps_temporary_vertices(scene, m, cc, cp);  // on the deformed capsule, where the forceps are
+            Vec3 cut_at = Vec3::Zero(), pull = Vec3::Zero();
+            const bool cutting = cystotome_contact(scene, m, cc, cut_at);
+            const bool pulling = !cutting && flap_pull(scene, m, cc, pull);
+            if (cutting || pulling) edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull);
             const double edit_ms = elapsed_ms(t0);
             cc.edit_ms_total += edit_ms;
             cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);

@@ -46,6 +46,7 @@ struct CapsuleCutting {
   double contact_mm = 0.05;      // cystotome tip this close to the capsule cuts,
   double penetration_mm = 0.5;   // and so does one pressed up to this far through it
   double min_lever_mm = 0.3;     // forceps this close to the tear's tip do not tear
+  uint32_t contact_hint = 0;     // where the last tool contact was located
   cut::CutPath stroke;           // the cystotome's current path
   cut::CutPath flap;             // the path the tear continues (the last stroke with a tip)
   tear::TearState tear_state;
