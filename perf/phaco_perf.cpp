@@ -46,7 +46,9 @@ studies:
   cut
       Cost of one cut step and one tear step on capsules of levels 0..6 (quick 3), both layouts;
       the cut's Hausdorff distance to the tool path, triangles added with and without remeshing,
-      and the scripted capsulorhexis's opening (diameter, circularity, centring) per level.
+      and the scripted capsulorhexis's opening (diameter, circularity, centring) per level; the
+      capsulorhexis demo in the scene at levels 1..5 (quick 1..2): cut system time, physics
+      rebuild after topology changes, frame time, opening.
   all
       foundation, bandwidth, membrane, cut.
 

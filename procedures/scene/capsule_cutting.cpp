@@ -287,6 +287,11 @@ nlohmann::json capsule_cutting_summary(Scene& scene) {
                       {"temporary_grasp_vertices_removed", cc->temporary_removed},
                       {"temporary_grasp_vertices_kept", cc->temporary_kept},
                       {"opening_complete", o.complete}};
+  nlohmann::json events = nlohmann::json::array();
+  for (const tear::TearEvent& e : ts.events)
+    events.push_back({{"kind", std::string(tear::to_string(e.kind))}, {"tear_step", e.step},
+                      {"radius_mm", e.radius_mm}, {"outward_angle_deg", e.outward_angle_deg}});
+  j["tear_events"] = events;
   if (o.complete) {
     j["opening_diameter_mm"] = o.diameter_mm;
     j["opening_circularity"] = o.circularity;
