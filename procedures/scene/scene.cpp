@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "components/from_mesh.hpp"
 #include "components/particles.hpp"
 #include "components/tets.hpp"
 #include "components/tool.hpp"
@@ -85,29 +86,6 @@ std::vector<uint8_t> rim_vertices(const SurfaceMesh& mesh) {
   return rim;
 }
 
-Particles make_particles(const std::vector<Vec3>& vertices) {
-  Particles p;
-  table_append(p, static_cast<uint32_t>(vertices.size()));
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    p.x[i] = static_cast<float>(vertices[i].x());
-    p.y[i] = static_cast<float>(vertices[i].y());
-    p.z[i] = static_cast<float>(vertices[i].z());
-    p.kind[i] = ParticleKind::Anchored;  // rigid until a system frees it
-  }
-  return p;
-}
-
-Triangles make_triangles(const SurfaceMesh& mesh) {
-  Triangles t;
-  table_append(t, static_cast<uint32_t>(mesh.triangles.size()));
-  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-    t.a[i] = mesh.triangles[i][0];
-    t.b[i] = mesh.triangles[i][1];
-    t.c[i] = mesh.triangles[i][2];
-  }
-  return t;
-}
-
 Tets make_tets(const TetMesh& mesh) {
   Tets t;
   table_append(t, static_cast<uint32_t>(mesh.tets.size()));
@@ -125,11 +103,11 @@ void add_body(Scene& scene, BodyPart part, const eye::EyeMeshes& meshes) {
   const Entity e = scene.world.create(EntityKind::Body, std::string(to_string(part)));
   scene.world.add(e, Body{part});
   if (part == BodyPart::Lens) {
-    scene.world.add(e, make_particles(meshes.lens_tets->vertices));
+    scene.world.add(e, particles_at(meshes.lens_tets->vertices, ParticleKind::Anchored, 0.0f));
     scene.world.add(e, make_tets(*meshes.lens_tets));
   } else {
     const SurfaceMesh& mesh = surface_of(meshes, part);
-    Particles particles = make_particles(mesh.vertices);
+    Particles particles = particles_at(mesh.vertices, ParticleKind::Anchored, 0.0f);  // rigid until a system frees it
     if (part == BodyPart::Capsule) {
       const auto mass = membrane_masses(mesh, scene.params.get("capsule.density_kg_m3"),
                                         scene.params.get("capsule.thickness_mm"));
@@ -140,7 +118,7 @@ void add_body(Scene& scene, BodyPart part, const eye::EyeMeshes& meshes) {
       }
     }
     scene.world.add(e, std::move(particles));
-    scene.world.add(e, make_triangles(mesh));
+    scene.world.add(e, triangles_of(mesh));
   }
   scene.bodies.push_back(e);
 }

@@ -7,6 +7,7 @@
 // (areal_density·A/3 per corner) when the material has a density, else inverse mass 1.
 #include <algorithm>
 
+#include "components/from_mesh.hpp"
 #include "engine/core/mesh_data.hpp"
 #include "systems/cut/membrane_edit.hpp"
 
@@ -26,19 +27,8 @@ struct MembraneSheet {
 inline MembraneSheet make_membrane_sheet(const SurfaceMesh& mesh, const MembraneMaterial& material) {
   MembraneSheet s;
   s.material = material;
-  table_append(s.particles, static_cast<uint32_t>(mesh.vertices.size()));
-  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-    s.particles.x[i] = static_cast<float>(mesh.vertices[i].x());
-    s.particles.y[i] = static_cast<float>(mesh.vertices[i].y());
-    s.particles.z[i] = static_cast<float>(mesh.vertices[i].z());
-    s.particles.inv_mass[i] = 1.0f;
-  }
-  table_append(s.triangles, static_cast<uint32_t>(mesh.triangles.size()));
-  for (size_t k = 0; k < mesh.triangles.size(); ++k) {
-    s.triangles.a[k] = mesh.triangles[k][0];
-    s.triangles.b[k] = mesh.triangles[k][1];
-    s.triangles.c[k] = mesh.triangles[k][2];
-  }
+  s.particles = particles_at(mesh.vertices, ParticleKind::Free, 1.0f);
+  s.triangles = triangles_of(mesh);
   s.springs = springs::build_springs(s.particles, s.triangles, s.material.springs);
   s.topology = build_topology(s.particles, s.triangles, s.springs);
   {

@@ -1,0 +1,39 @@
+#pragma once
+// The particle and triangle tables of a body built from a mesh's vertices and triangles: the one
+// conversion the scene, the cut's membrane sheet and the tests all use.
+#include <cstdint>
+#include <vector>
+
+#include "components/particles.hpp"
+#include "components/triangles.hpp"
+#include "engine/core/math.hpp"
+#include "engine/core/mesh_data.hpp"
+
+namespace phaco {
+
+// One particle per vertex, at rest, of the given kind and inverse mass.
+inline Particles particles_at(const std::vector<Vec3>& vertices, ParticleKind kind, float inv_mass) {
+  Particles p;
+  table_append(p, static_cast<uint32_t>(vertices.size()));
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    p.x[i] = static_cast<float>(vertices[i].x());
+    p.y[i] = static_cast<float>(vertices[i].y());
+    p.z[i] = static_cast<float>(vertices[i].z());
+    p.inv_mass[i] = inv_mass;
+    p.kind[i] = kind;
+  }
+  return p;
+}
+
+inline Triangles triangles_of(const SurfaceMesh& mesh) {
+  Triangles t;
+  table_append(t, static_cast<uint32_t>(mesh.triangles.size()));
+  for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+    t.a[k] = mesh.triangles[k][0];
+    t.b[k] = mesh.triangles[k][1];
+    t.c[k] = mesh.triangles[k][2];
+  }
+  return t;
+}
+
+}  // namespace phaco
