@@ -1,11 +1,18 @@
 #pragma once
 // Tetrahedra of a volumetric body (the lens), by particle index, positively oriented.
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "engine/core/table.hpp"
 
 namespace phaco {
+
+// Face k of a positively oriented tet (a, b, c, d) is the face opposite local vertex k; its
+// corners, counter-clockwise seen from outside the tet:
+//   0: (b, c, d)   1: (a, d, c)   2: (a, b, d)   3: (a, c, b)
+inline constexpr std::array<std::array<uint8_t, 3>, 4> kTetFaceCorners = {
+    {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 
 struct Tets {
   SlotIndex slots;

@@ -1,0 +1,96 @@
+#include "systems/sph/contact.hpp"
+
+#include <cmath>
+
+#include "engine/schedule/parallel.hpp"
+#include "systems/sph/kernel.hpp"
+#include "systems/sph/neighbours.hpp"
+
+namespace phaco::sph {
+
+namespace {
+
+constexpr uint32_t kGrain = 256;
+
+// ∫ u(1 − u²)² du = −(1 − u²)³/6, normalised by the peak u_p(1 − u_p²)², u_p = 1/√5; below
+// u_p the shape is 1.
+double shape_integral(double from) {
+  const double up = 1.0 / std::sqrt(5.0);
+  const double peak = up * (1.0 - up * up) * (1.0 - up * up);
+  const double a = std::max(from, up);
+  const double tail = std::pow(1.0 - a * a, 3) / 6.0 / peak;  // ∫_a^1
+  return tail + std::max(0.0, up - from);                     // + ∫_from^up of 1
+}
+
+}  // namespace
+
+float pair_force_scale(const ContactParams& p, float r2, float vdotd) {
+  if (!(r2 > 0.0f)) return 0.0f;  // coincident (or NaN): no direction
+  const float h2 = p.h * p.h;
+  if (r2 >= h2) return 0.0f;
+  const float r = std::sqrt(r2);
+  const float rp2 = h2 * 0.2f;  // (h/√5)²
+  const float rc2 = std::max(r2, rp2);
+  const float rc = std::sqrt(rc2);
+  const float dp = h2 - rp2;
+  const float dc = h2 - rc2;
+  const float shape = (rc * dc * dc) / (std::sqrt(rp2) * dp * dp);  // ĝ(r) ∈ [0, 1]
+  const float vn = vdotd / r;                                       // < 0 when approaching
+  const float magnitude = std::max(0.0f, p.stiffness * p.h - p.damping * vn) * shape;
+  return magnitude / r;
+}
+
+ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_count,
+                              const ContactParams& params, ContactScratch& scratch,
+                              std::span<float> fx, std::span<float> fy, std::span<float> fz) {
+  ContactStats stats;
+  if (fragment_count < 2) return stats;
+  const auto n = static_cast<uint32_t>(in.x.size());
+  scratch.members.clear();
+  for (uint32_t i = 0; i < n; ++i)
+    if (in.boundary[i]) scratch.members.push_back(i);
+  stats.particles = static_cast<uint32_t>(scratch.members.size());
+  if (stats.particles < 2) return stats;
+  Grid& g = scratch.grid;
+  build_grid(g, in.x, in.y, in.z, {}, params.h, params.order, scratch.members);
+
+  const uint64_t twice = parallel_reduce_ordered(
+      0u, g.count, kGrain, uint64_t{0},
+      [&](uint32_t b, uint32_t e) {
+        uint64_t pairs = 0;
+        float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+        for_each_neighbour(
+            g, b, e,
+            [&](uint32_t i, uint32_t j, float dx, float dy, float dz, float r2) {
+              const uint32_t pi = g.id[i], pj = g.id[j];
+              if (in.fragment[pj] == in.fragment[pi]) return;
+              const float vd = (in.vx[pi] - in.vx[pj]) * dx + (in.vy[pi] - in.vy[pj]) * dy +
+                               (in.vz[pi] - in.vz[pj]) * dz;
+              const float s = pair_force_scale(params, r2, vd);
+              sx += s * dx;
+              sy += s * dy;
+              sz += s * dz;
+              ++pairs;
+            },
+            [&](uint32_t i) {
+              const uint32_t pi = g.id[i];
+              fx[pi] += sx;
+              fy[pi] += sy;
+              fz[pi] += sz;
+              sx = sy = sz = 0.0f;
+            });
+        return pairs;
+      },
+      [](uint64_t a, uint64_t b) { return a + b; });
+  stats.pairs = twice / 2;
+  return stats;
+}
+
+float stiffness_to_stop(float relative_speed, float reduced_mass, float h, float stop_fraction) {
+  const double v = relative_speed;
+  const double energy = 0.5 * static_cast<double>(reduced_mass) * v * v;
+  const double hh = static_cast<double>(h) * h;
+  return static_cast<float>(energy / (hh * shape_integral(stop_fraction)));
+}
+
+}  // namespace phaco::sph
