@@ -49,8 +49,15 @@ studies:
       and the scripted capsulorhexis's opening (diameter, circularity, centring) per level; the
       capsulorhexis demo in the scene at levels 1..5 (quick 1..2): cut system time, physics
       rebuild after topology changes, frame time, opening.
+  lens [--no-million]
+      Issue 5, the lens: tetrahedral sculpting per level 0,1,2,3,5,7 (quick 0,1) x broadphase (octree,
+      btDbvt) x narrowphase (centre, GJK, MPR) against the exact swept volume; simplex cells (removal,
+      boundary, fragment labelling); shape matching (Horn vs polar decomposition on degenerate
+      fragments, float vs double, cost per fragment, the whole-lens pass); the SPH neighbour search at
+      10k, 100k and 1M particles (quick 10k; --no-million skips 1M) per cell order; the lens tools;
+      the fragmenting lens per frame; the divide-and-conquer demo per level.
   all
-      foundation, bandwidth, membrane, cut.
+      foundation, bandwidth, membrane, cut, lens.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -87,12 +94,16 @@ int main(int argc, char** argv) {
       perf::run_membrane(options);
     } else if (cmd == "cut") {
       perf::run_cut(options);
+    } else if (cmd == "lens") {
+      perf::run_lens(options);
     } else if (cmd == "all") {
-      if (!options.extra.empty()) throw InputError("all: unknown option '" + options.extra[0] + "'");
+      if (!options.extra.empty())
+        throw InputError("all: unknown option '" + options.extra[0] + "'");
       perf::run_foundation(options);
       perf::run_bandwidth(options);
       perf::run_membrane(options);
       perf::run_cut(options);
+      perf::run_lens(options);
     } else {
       std::fprintf(stderr, "phaco-perf: unknown study '%s' (try --help)\n", cmd.c_str());
       return 2;

@@ -9,15 +9,16 @@
 namespace phaco::perf {
 
 struct StudyOptions {
-  bool quick = false;                 // small levels, few steps: about a minute, for CI
-  std::filesystem::path out_dir;      // holds RESULTS.md and results/
-  std::vector<std::string> extra;     // study-specific options left after the common ones
+  bool quick = false;              // small levels, few steps: about a minute, for CI
+  std::filesystem::path out_dir;   // holds RESULTS.md and results/
+  std::vector<std::string> extra;  // study-specific options left after the common ones
 };
 
 void run_foundation(const StudyOptions& options);
 void run_bandwidth(const StudyOptions& options);
 void run_membrane(const StudyOptions& options);
 void run_cut(const StudyOptions& options);
+void run_lens(const StudyOptions& options);
 
 // Rewrites out_dir/RESULTS.md from the machine description and the sections in out_dir/results.
 void regenerate_results(const std::filesystem::path& out_dir);

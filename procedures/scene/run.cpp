@@ -8,6 +8,8 @@
 #include "engine/core/clock.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/lens_fragments.hpp"
+#include "procedures/scene/lens_sculpting.hpp"
 
 namespace phaco {
 
@@ -48,8 +50,14 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
   r.mesh_load_s = scene->mesh_load_s;
   r.elements = element_counts(*scene);
   r.state_hash = state_hash(*scene);
-  if (auto capsule = capsule_physics_summary(*scene); !capsule.is_null()) r.physics["capsule"] = capsule;
-  if (auto cutting = capsule_cutting_summary(*scene); !cutting.is_null()) r.physics["capsule_cutting"] = cutting;
+  if (auto capsule = capsule_physics_summary(*scene); !capsule.is_null())
+    r.physics["capsule"] = capsule;
+  if (auto cutting = capsule_cutting_summary(*scene); !cutting.is_null())
+    r.physics["capsule_cutting"] = cutting;
+  if (auto lens = lens_sculpting_summary(*scene); !lens.is_null())
+    r.physics["lens_sculpting"] = lens;
+  if (auto lens = lens_fragments_summary(*scene); !lens.is_null())
+    r.physics["lens_fragments"] = lens;
   r.peak_memory_mb = peak_memory_mb();
   return r;
 }
@@ -67,7 +75,8 @@ nlohmann::json to_json(const RunReport& r) {
     systems[s.name] = {{"p50_ms", s.p50_ms}, {"p99_ms", s.p99_ms}, {"mean_ms", s.mean_ms}};
   }
   j["systems"] = systems;
-  j["frame"] = {{"p50_ms", r.frame.p50_ms}, {"p99_ms", r.frame.p99_ms}, {"mean_ms", r.frame.mean_ms}};
+  j["frame"] = {
+      {"p50_ms", r.frame.p50_ms}, {"p99_ms", r.frame.p99_ms}, {"mean_ms", r.frame.mean_ms}};
   j["wall_time_s"] = r.wall_time_s;
   j["mesh_load_s"] = r.mesh_load_s;
   j["peak_memory_mb"] = r.peak_memory_mb;
@@ -84,15 +93,18 @@ nlohmann::json to_json(const RunReport& r) {
 std::string summary_text(const RunReport& r) {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%s  drill %s  %llu frames (%.3f s simulated at dt %.6f s)  %d thread(s)\n",
+  std::snprintf(line, sizeof line,
+                "%s  drill %s  %llu frames (%.3f s simulated at dt %.6f s)  %d thread(s)\n",
                 r.scenario.c_str(), r.drill.c_str(), static_cast<unsigned long long>(r.frames),
                 r.sim_time_s, r.dt_s, r.threads);
   out += line;
-  std::snprintf(line, sizeof line, "frame   p50 %.4f ms  p99 %.4f ms   (stepping took %.3f s wall, meshes %.3f s)\n",
+  std::snprintf(line, sizeof line,
+                "frame   p50 %.4f ms  p99 %.4f ms   (stepping took %.3f s wall, meshes %.3f s)\n",
                 r.frame.p50_ms, r.frame.p99_ms, r.wall_time_s, r.mesh_load_s);
   out += line;
   for (const auto& s : r.systems) {
-    std::snprintf(line, sizeof line, "  %-22s p50 %.4f ms  p99 %.4f ms\n", s.name.c_str(), s.p50_ms, s.p99_ms);
+    std::snprintf(line, sizeof line, "  %-22s p50 %.4f ms  p99 %.4f ms\n", s.name.c_str(), s.p50_ms,
+                  s.p99_ms);
     out += line;
   }
   out += "elements:";
@@ -100,27 +112,68 @@ std::string summary_text(const RunReport& r) {
   for (const auto& [body, ph] : r.physics.items()) {
     if (body == "capsule_cutting") {
       std::snprintf(line, sizeof line,
-                    "\ncapsule cutting: %llu cut segments, %llu tear steps (%llu advanced, rule %s), %llu run-out "
+                    "\ncapsule cutting: %llu cut segments, %llu tear steps (%llu advanced, rule "
+                    "%s), %llu run-out "
                     "warnings, %llu radial tear-outs, opening %s",
-                    ph.value("cut_segments", 0ull), ph.value("tear_steps", 0ull), ph.value("tear_advances", 0ull),
-                    ph.value("tear_rule", std::string("?")).c_str(), ph.value("runout_warnings", 0ull),
-                    ph.value("radial_tearouts", 0ull), ph.value("opening_complete", false) ? "closed" : "not closed");
+                    ph.value("cut_segments", 0ull), ph.value("tear_steps", 0ull),
+                    ph.value("tear_advances", 0ull),
+                    ph.value("tear_rule", std::string("?")).c_str(),
+                    ph.value("runout_warnings", 0ull), ph.value("radial_tearouts", 0ull),
+                    ph.value("opening_complete", false) ? "closed" : "not closed");
       out += line;
       if (ph.value("opening_complete", false)) {
-        std::snprintf(line, sizeof line, " (diameter %.2f mm, circularity %.3f)", ph.value("opening_diameter_mm", 0.0),
-                      ph.value("opening_circularity", 0.0));
+        std::snprintf(line, sizeof line, " (diameter %.2f mm, circularity %.3f)",
+                      ph.value("opening_diameter_mm", 0.0), ph.value("opening_circularity", 0.0));
+        out += line;
+      }
+      continue;
+    }
+    if (body == "lens_fragments") {
+      std::snprintf(line, sizeof line,
+                    "\nlens fragments: %llu of %llu cells removed (%.2f mm3), %llu fragment(s) "
+                    "now, %llu at most, "
+                    "step mean %.3f ms / max %.3f ms",
+                    ph.value("cells_removed", 0ull), ph.value("cells", 0ull),
+                    ph.value("volume_removed_mm3", 0.0), ph.value("fragments", 0ull),
+                    ph.value("max_fragments", 0ull), ph.value("step_ms_mean", 0.0),
+                    ph.value("step_ms_max", 0.0));
+      out += line;
+      continue;
+    }
+    if (body == "lens_sculpting") {
+      std::snprintf(line, sizeof line,
+                    "\nlens sculpting: %llu tets removed (%.2f mm3) in %llu strokes, ultrasound "
+                    "%.2f s, sculpt step "
+                    "mean %.3f ms / max %.3f ms, nucleus turned %.1f deg, %llu trench(es)",
+                    ph.value("tets_removed", 0ull), ph.value("volume_removed_mm3", 0.0),
+                    ph.value("strokes", 0ull), ph.value("ultrasound_time_s", 0.0),
+                    ph.value("sculpt_ms_mean", 0.0), ph.value("sculpt_ms_max", 0.0),
+                    ph.value("nucleus_rotation_deg", 0.0), ph.value("trench_count", 0ull));
+      out += line;
+      for (const auto& t : ph.value("trenches", nlohmann::json::array())) {
+        std::snprintf(
+            line, sizeof line,
+            "\n  trench: width %.2f mm, depth %.2f mm (%.0f %% of the nucleus), axis %.0f deg",
+            t.value("width_mm", 0.0), t.value("depth_mm", 0.0),
+            100.0 * t.value("depth_fraction", 0.0), t.value("axis_deg", 0.0));
+        out += line;
+      }
+      if (ph.value("trench_count", 0ull) >= 2) {
+        std::snprintf(line, sizeof line, "\n  trenches cross at %.1f deg",
+                      ph.value("trench_crossing_angle_deg", 0.0));
         out += line;
       }
       continue;
     }
     out += "\n" + body + ": " + ph.value("integrator", std::string("?")) + ", active set mean " +
-           std::to_string(static_cast<long long>(ph.value("active_particles_mean", 0.0))) + " / max " +
-           std::to_string(ph.value("active_particles_max", 0u)) + " particles, " +
+           std::to_string(static_cast<long long>(ph.value("active_particles_mean", 0.0))) +
+           " / max " + std::to_string(ph.value("active_particles_max", 0u)) + " particles, " +
            std::to_string(ph.value("frames_stepped", 0ull)) + " frames stepped, " +
-           std::to_string(ph.value("divergences", 0ull)) + " divergences, " + std::to_string(ph.value("grasps", 0ull)) +
-           " grasps";
+           std::to_string(ph.value("divergences", 0ull)) + " divergences, " +
+           std::to_string(ph.value("grasps", 0ull)) + " grasps";
   }
-  std::snprintf(line, sizeof line, "\npeak memory %.1f MiB   metrics %zu   events %zu   state hash %s\n",
+  std::snprintf(line, sizeof line,
+                "\npeak memory %.1f MiB   metrics %zu   events %zu   state hash %s\n",
                 r.peak_memory_mb, r.metrics.size(), r.events.size(), r.state_hash.c_str());
   out += line;
   return out;

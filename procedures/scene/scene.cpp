@@ -15,6 +15,8 @@
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/lens_fragments.hpp"
+#include "procedures/scene/lens_sculpting.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
 
 namespace phaco {
@@ -28,8 +30,8 @@ std::vector<std::string> to_strings(std::span<const char* const> names) {
 }
 
 eye::EyeParams load_params(const Scenario& s) {
-  eye::EyeParams params = s.eye.params_file ? eye::load_eye_params(*s.eye.params_file)
-                                            : eye::default_eye_params();
+  eye::EyeParams params =
+      s.eye.params_file ? eye::load_eye_params(*s.eye.params_file) : eye::default_eye_params();
   for (const auto& [key, value] : s.eye.overrides) {
     try {
       eye::apply_override(params, key, value);
@@ -42,16 +44,22 @@ eye::EyeParams load_params(const Scenario& s) {
 
 const SurfaceMesh& surface_of(const eye::EyeMeshes& m, BodyPart part) {
   switch (part) {
-    case BodyPart::Cornea: return m.cornea;
-    case BodyPart::Capsule: return m.capsule;
-    case BodyPart::Iris: return m.iris;
-    case BodyPart::Globe: return m.globe;
-    default: return m.lens_surface;
+    case BodyPart::Cornea:
+      return m.cornea;
+    case BodyPart::Capsule:
+      return m.capsule;
+    case BodyPart::Iris:
+      return m.iris;
+    case BodyPart::Globe:
+      return m.globe;
+    default:
+      return m.lens_surface;
   }
 }
 
 // Lumped mass of a membrane: each triangle gives a third of ρ·h·A to each corner.
-std::vector<double> membrane_masses(const SurfaceMesh& mesh, double density_kg_m3, double thickness_mm) {
+std::vector<double> membrane_masses(const SurfaceMesh& mesh, double density_kg_m3,
+                                    double thickness_mm) {
   std::vector<double> mass(mesh.vertices.size(), 0.0);
   for (const auto& t : mesh.triangles) {
     const Vec3& a = mesh.vertices[t[0]];
@@ -107,7 +115,8 @@ void add_body(Scene& scene, BodyPart part, const eye::EyeMeshes& meshes) {
     scene.world.add(e, make_tets(*meshes.lens_tets));
   } else {
     const SurfaceMesh& mesh = surface_of(meshes, part);
-    Particles particles = particles_at(mesh.vertices, ParticleKind::Anchored, 0.0f);  // rigid until a system frees it
+    Particles particles =
+        particles_at(mesh.vertices, ParticleKind::Anchored, 0.0f);  // rigid until a system frees it
     if (part == BodyPart::Capsule) {
       const auto mass = membrane_masses(mesh, scene.params.get("capsule.density_kg_m3"),
                                         scene.params.get("capsule.thickness_mm"));
@@ -140,18 +149,31 @@ void replace_meshes_from_files(const Scenario& s, eye::EyeMeshes& meshes) {
   }
 }
 
+bool is_lens_method(const std::string& key) {
+  return key == "lens.model" || key == "lens.broadphase" || key == "lens.narrowphase";
+}
+
 // Every `methods` key must name a setting of a body this drill's scene has.
 void check_methods(const Scenario& s, const std::vector<BodyPart>& parts) {
-  const bool has_capsule = std::find(parts.begin(), parts.end(), BodyPart::Capsule) != parts.end();
+  auto has = [&](BodyPart part) {
+    return std::find(parts.begin(), parts.end(), part) != parts.end();
+  };
   for (const auto& [key, value] : s.methods) {
-    if (!is_capsule_method(key)) {
-      throw InputError(s.source + ": methods[\"" + key +
-                       "\"]: unknown method setting; expected one of: capsule.integrator, capsule.spring_law, "
-                       "capsule.stiffness, capsule.pretension, capsule.active_set");
+    const bool capsule = is_capsule_method(key), lens = is_lens_method(key);
+    if (!capsule && !lens) {
+      throw InputError(
+          s.source + ": methods[\"" + key +
+          "\"]: unknown method setting; expected one of: capsule.integrator, capsule.spring_law, "
+          "capsule.stiffness, capsule.pretension, capsule.active_set, capsule.cutting, "
+          "capsule.tear_rule, lens.model, lens.broadphase, lens.narrowphase");
     }
-    if (!has_capsule) {
-      throw InputError(s.source + ": methods[\"" + key + "\"]: the " + std::string(to_string(s.drill)) +
-                       " scene has no capsule");
+    if (capsule && !has(BodyPart::Capsule)) {
+      throw InputError(s.source + ": methods[\"" + key + "\"]: the " +
+                       std::string(to_string(s.drill)) + " scene has no capsule");
+    }
+    if (lens && !has(BodyPart::Lens)) {
+      throw InputError(s.source + ": methods[\"" + key + "\"]: the " +
+                       std::string(to_string(s.drill)) + " scene has no tetrahedral lens");
     }
   }
 }
@@ -165,8 +187,8 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
                      .run = [&scene](const FrameContext& ctx) {
                        const double t_end = ctx.time_s + ctx.dt_s;
                        for (Entity e : scene.tools) {
-                         tool_motion::move_tool(scene.world.at<ToolTrack>(e), scene.world.at<ToolState>(e),
-                                                t_end);
+                         tool_motion::move_tool(scene.world.at<ToolTrack>(e),
+                                                scene.world.at<ToolState>(e), t_end);
                        }
                      }});
   // The frame's one sync point for structural change (DESIGN.md §4, step 3).
@@ -182,10 +204,12 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
 
 std::vector<BodyPart> bodies_for(Drill drill) {
   switch (drill) {
-    case Drill::CornealIncision: return {BodyPart::Cornea, BodyPart::Iris, BodyPart::Globe};
+    case Drill::CornealIncision:
+      return {BodyPart::Cornea, BodyPart::Iris, BodyPart::Globe};
     case Drill::Capsulorhexis:
       return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::LensSurface};
-    case Drill::PhacoSculpting: return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::Lens};
+    case Drill::PhacoSculpting:
+      return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::Lens};
   }
   return {};
 }
@@ -208,7 +232,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   check_methods(scenario, parts);
   const bool need_tets = std::find(parts.begin(), parts.end(), BodyPart::Lens) != parts.end();
   const auto layout = scenario.eye.capsule_layout == "isotropic" ? eye::CapsuleLayout::Isotropic
-                                                                  : eye::CapsuleLayout::Curvilinear;
+                                                                 : eye::CapsuleLayout::Curvilinear;
   Stopwatch mesh_clock;
   eye::MeshCache cache(options.cache_dir.value_or(eye::MeshCache::default_dir()));
   eye::EyeMeshes meshes = cache.load_or_build(scene->params, scene->resolution, layout, need_tets);
@@ -230,6 +254,15 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
     add_capsule_physics(*scene);
     systems.push_back(capsule_dynamics_system(*scene));
     if (add_capsule_cutting(*scene)) systems.push_back(capsule_cut_system(*scene));
+  }
+  if (scene->body(BodyPart::Lens)) {
+    if (lens_model(*scene) == "fragments") {
+      add_lens_fragments(*scene);
+      systems.push_back(lens_fragments_system(*scene));
+    } else {
+      add_lens_sculpting(*scene);
+      systems.push_back(lens_sculpt_system(*scene));
+    }
   }
   if (options.extra_systems) {
     for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));
@@ -266,11 +299,15 @@ std::string state_hash(const Scene& scene) {
       h.add(t->slots.alive_mask());
       for (const auto* col : {&t->a, &t->b, &t->c, &t->d}) h.add(std::span<const uint32_t>(*col));
     }
+    if (const LensFragments* lf = world.get<LensFragments>(e)) {
+      const SimplexCells& c = lf->lens.cells;
+      for (const auto* col : {&c.x, &c.y, &c.z}) h.add(std::span<const float>(*col));
+    }
   }
   for (Entity e : scene.tools) {
     const ToolState& s = world.at<ToolState>(e);
-    const double v[] = {s.pos.x(), s.pos.y(), s.pos.z(), s.quat.w(), s.quat.x(), s.quat.y(),
-                        s.quat.z(), s.grip, s.pedal};
+    const double v[] = {s.pos.x(),  s.pos.y(),  s.pos.z(), s.quat.w(), s.quat.x(),
+                        s.quat.y(), s.quat.z(), s.grip,    s.pedal};
     h.add(std::span<const double>(v));
   }
   return h.hex();
@@ -280,9 +317,12 @@ std::vector<std::pair<std::string, uint64_t>> element_counts(const Scene& scene)
   std::vector<std::pair<std::string, uint64_t>> out;
   for (Entity e : scene.bodies) {
     const std::string& name = scene.world.name(e);
-    if (const auto* p = scene.world.get<Particles>(e)) out.push_back({name + ".particles", p->slots.live_count()});
-    if (const auto* t = scene.world.get<Triangles>(e)) out.push_back({name + ".triangles", t->slots.live_count()});
-    if (const auto* t = scene.world.get<Tets>(e)) out.push_back({name + ".tets", t->slots.live_count()});
+    if (const auto* p = scene.world.get<Particles>(e))
+      out.push_back({name + ".particles", p->slots.live_count()});
+    if (const auto* t = scene.world.get<Triangles>(e))
+      out.push_back({name + ".triangles", t->slots.live_count()});
+    if (const auto* t = scene.world.get<Tets>(e))
+      out.push_back({name + ".tets", t->slots.live_count()});
   }
   out.push_back({"tools", scene.tools.size()});
   return out;

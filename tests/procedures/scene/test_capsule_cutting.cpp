@@ -14,25 +14,17 @@
 #include "procedures/scene/run.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/topology_check/topology_check.hpp"
+#include "tests/support/scene_run.hpp"
 
 namespace phaco {
 namespace {
 
-std::filesystem::path cache_dir() {
-  const char* env = std::getenv("PHACO_CACHE_DIR");
-  return env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "phaco-test-cache";
+Scenario demo() {
+  return test::repo_scenario("capsulorhexis_demo.json");
 }
 
-Scenario demo() { return load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) / "data/scenarios/capsulorhexis_demo.json"); }
-
 std::unique_ptr<Scene> run_all(const Scenario& s, int threads) {
-  SceneOptions o;
-  o.threads = threads;
-  o.cache_dir = cache_dir();
-  auto scene = build_scene(s, o);
-  const auto frames = static_cast<uint64_t>(std::llround(s.duration_s / s.dt_s));
-  for (uint64_t f = 0; f < frames; ++f) step(*scene);
-  return scene;
+  return test::run_to_end(s, threads);
 }
 
 TEST(CapsuleCutting, TheDemoCutsAndTearsTheCapsuleAndKeepsItSound) {
@@ -61,7 +53,8 @@ TEST(CapsuleCutting, TheDemoCutsAndTearsTheCapsuleAndKeepsItSound) {
   bool warned = false;
   for (const auto& e : cc->tear_state.events) {
     if (e.kind == tear::TearEvent::RunoutWarning) warned = true;
-    if (e.kind == tear::TearEvent::RadialTearout) EXPECT_TRUE(warned) << "tear-out without a warning first";
+    if (e.kind == tear::TearEvent::RadialTearout)
+      EXPECT_TRUE(warned) << "tear-out without a warning first";
   }
   // The demo's forceps close the circle: the disc comes free, round and about the target size.
   const nlohmann::json j = capsule_cutting_summary(*scene);
@@ -117,7 +110,7 @@ TEST(CapsuleCutting, CanBeSwitchedOffAndRejectsAnUnknownRule) {
   Scenario bad = demo();
   bad.methods["capsule.tear_rule"] = "scissors";
   SceneOptions o;
-  o.cache_dir = cache_dir();
+  o.cache_dir = test::scene_cache_dir();
   EXPECT_THROW(build_scene(bad, o), InputError);
 }
 
