@@ -3,25 +3,81 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/schedule/parallel.hpp"
 #include "systems/sph/environment.hpp"
 
 namespace phaco::lens {
 namespace {
+
+constexpr uint32_t kCellGrain = 4096;  // per-cell passes: chunks of cells, in parallel
 
 CellSpans spans(FragmentLens& l) {
   return {l.cells.x, l.cells.y,    l.cells.z,     l.vx,      l.vy,
           l.vz,      l.cells.mass, l.cells.alive, l.hardness};
 }
 
-// A cell takes part in fragment contact when it has an external face.
+// Which cells take part in fragment contact: cells with an external face (seed 002 §6.1, boundary
+// cells only) that lie where their fragment's box meets another fragment's box, both widened by
+// the support h. Pairs of boxes come from a sweep along x. Fragments far apart, and the far sides
+// of fragments in contact, add nothing to the contact grid (model no more than the scene needs).
 void mark_boundary(FragmentLens& l) {
-  const uint32_t n = l.cells.size();
+  const uint32_t n = l.cells.size(), nf = l.fragments.count;
+  const float h = l.settings.contact.h;
+  auto& box = l.fragment_box;  // per fragment: min x, y, z, max x, y, z of its boundary cells
+  box.assign(nf, {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f});
   for (uint32_t c = 0; c < n; ++c) {
     uint8_t b = 0;
     if (l.cells.alive[c]) {
       for (uint32_t k = 0; k < 4; ++k) b |= l.cells.neighbour[c][k] == kNoSimplex;
     }
     l.boundary[c] = b;
+    if (!b) continue;
+    auto& bx = box[l.fragments.label[c]];
+    const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
+    for (int a = 0; a < 3; ++a)
+      bx[a] = std::min(bx[a], p[a] - h), bx[a + 3] = std::max(bx[a + 3], p[a] + h);
+  }
+  // Overlaps of the widened boxes: a sweep over the fragments sorted by min x.
+  auto& order = l.fragment_order;
+  order.resize(nf);
+  for (uint32_t f = 0; f < nf; ++f) order[f] = f;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return box[a][0] < box[b][0] || (box[a][0] == box[b][0] && a < b);
+  });
+  auto& overlaps = l.overlaps;  // (fragment, box of the region it shares with another)
+  overlaps.clear();
+  for (uint32_t i = 0; i < nf; ++i) {
+    const auto& a = box[order[i]];
+    for (uint32_t j = i + 1; j < nf && box[order[j]][0] <= a[3]; ++j) {
+      const auto& b = box[order[j]];
+      std::array<float, 6> r;
+      bool meet = true;
+      for (int k = 0; k < 3; ++k) {
+        r[k] = std::max(a[k], b[k]), r[k + 3] = std::min(a[k + 3], b[k + 3]);
+        meet &= r[k] <= r[k + 3];
+      }
+      if (!meet) continue;
+      overlaps.push_back({order[i], r});
+      overlaps.push_back({order[j], r});
+    }
+  }
+  std::sort(overlaps.begin(), overlaps.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  auto& first = l.fragment_first_overlap;  // CSR into overlaps, per fragment
+  first.assign(nf + 1, 0);
+  for (const auto& o : overlaps) ++first[o.first + 1];
+  for (uint32_t f = 0; f < nf; ++f) first[f + 1] += first[f];
+  for (uint32_t c = 0; c < n; ++c) {
+    if (!l.boundary[c]) continue;
+    const uint32_t f = l.fragments.label[c];
+    const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
+    uint8_t in = 0;
+    for (uint32_t k = first[f]; k < first[f + 1] && !in; ++k) {
+      const auto& r = overlaps[k].second;
+      in = p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] && p[2] >= r[2] &&
+           p[2] <= r[5];
+    }
+    l.boundary[c] = in;
   }
 }
 
@@ -92,21 +148,25 @@ void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
 
 void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   const uint32_t n = l.cells.size();
-  for (uint32_t c = 0; c < n; ++c) {
-    l.current[c] = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
-    l.match_mass[c] = sph::heavy_weight(l.cells.mass[c], l.contact[c] | l.pushed[c]);
-  }
+  parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    for (uint32_t c = b; c < e; ++c) {
+      l.current[c] = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+      l.match_mass[c] = sph::heavy_weight(l.cells.mass[c], l.contact[c] | l.pushed[c]);
+    }
+  });
   const shape_match::FragmentList list{l.fragments.offsets, l.fragments.members};
   st.match = shape_match::match_lens<float>(l.rest, l.current, l.match_mass, list, l.rotations,
                                             l.settings.match);
   const float inv_dt = static_cast<float>(1.0 / dt_s);
-  for (uint32_t c = 0; c < n; ++c) {
-    if (!l.cells.alive[c]) continue;
-    const Vec3f d = l.current[c] - Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
-    l.cells.x[c] = l.current[c].x(), l.cells.y[c] = l.current[c].y(),
-    l.cells.z[c] = l.current[c].z();
-    l.vx[c] += d.x() * inv_dt, l.vy[c] += d.y() * inv_dt, l.vz[c] += d.z() * inv_dt;
-  }
+  parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    for (uint32_t c = b; c < e; ++c) {
+      if (!l.cells.alive[c]) continue;
+      const Vec3f d = l.current[c] - Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+      l.cells.x[c] = l.current[c].x(), l.cells.y[c] = l.current[c].y(),
+      l.cells.z[c] = l.current[c].z();
+      l.vx[c] += d.x() * inv_dt, l.vy[c] += d.y() * inv_dt, l.vz[c] += d.z() * inv_dt;
+    }
+  });
 }
 
 }  // namespace

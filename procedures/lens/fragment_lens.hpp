@@ -21,9 +21,11 @@
 //      against the constraint instead of being pulled back through it.
 // Until a tool first touches the lens (a removal, a hook or aspirator contact) the lens is asleep:
 // nothing moves and nothing is computed (model no more than the scene needs).
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "components/fragments.hpp"
@@ -84,7 +86,10 @@ struct FragmentLens {
   std::vector<Vec3f> rest, current;
   std::vector<float> match_mass;  // per cell: mass, ×sph::kHeavyMassFactor while in contact
   std::vector<float> fx, fy, fz;
-  std::vector<uint8_t> boundary;
+  std::vector<uint8_t> boundary;  // per cell: takes part in fragment contact this step
+  std::vector<std::array<float, 6>> fragment_box;  // contact regions (fragment_lens.cpp)
+  std::vector<uint32_t> fragment_order, fragment_first_overlap;
+  std::vector<std::pair<uint32_t, std::array<float, 6>>> overlaps;
   std::vector<uint8_t> pushed;  // per cell: fragment contact moved it this step
   std::vector<uint32_t> fragment_of;
   sph::ContactScratch contact_scratch;

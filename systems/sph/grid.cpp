@@ -273,10 +273,8 @@ Run hash_cell(const Grid& g, int64_t ix, int64_t iy, int64_t iz) {
 
 namespace {
 
-// Sub-cell runs: for each octant, the 27 sub-cells of edge h around the particle's sub-cell,
-// enumerated x fastest; a sub-cell whose slots follow the previous run's extends it.
-void subcell_runs(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& out) {
-  uint32_t parent[3][3][3];  // cell index of (ix + dx − 1, ...), kNoSlot when empty
+// Sub-cell grids: the 27 cells around `c` (kNoSlot where empty).
+void subcell_parents(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& out) {
   for (int dz = 0; dz < 3; ++dz)
     for (int dy = 0; dy < 3; ++dy)
       for (int dx = 0; dx < 3; ++dx) {
@@ -295,70 +293,91 @@ void subcell_runs(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& out
               idx = static_cast<uint32_t>(it - g.cell_key.begin());
           }
         }
-        parent[dz][dy][dx] = idx;
+        out.parent[(dz * 3 + dy) * 3 + dx] = idx;
       }
-  for (int o = 0; o < 8; ++o) {
-    // Sub-cell coordinate of the octant relative to the parent block's lowest sub-cell (2 = own
-    // cell's lower half): s = 2 + bit, neighbours s − 1 … s + 1.
-    const int sx = 2 + (o & 1), sy = 2 + ((o >> 1) & 1), sz = 2 + ((o >> 2) & 1);
-    int m = 0;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int ux = sx + dx, uy = sy + dy, uz = sz + dz;  // in [1, 4]
-          const uint32_t p = parent[uz >> 1][uy >> 1][ux >> 1];
-          if (p == kNoSlot) continue;
-          const uint32_t so = static_cast<uint32_t>((ux & 1) | (uy & 1) << 1 | (uz & 1) << 2);
-          const Run r{g.sub_begin[8 * size_t{p} + so], g.sub_begin[8 * size_t{p} + so + 1]};
-          if (r.begin == r.end) continue;
-          if (m > 0 && out.runs[o][m - 1].end == r.begin)
-            out.runs[o][m - 1].end = r.end;
-          else
-            out.runs[o][m++] = r;
+}
+
+// Sub-cell runs of octant o: the 27 sub-cells of edge h around the particle's sub-cell,
+// enumerated x fastest; a sub-cell whose slots follow the previous run's extends it.
+void subcell_octant(const Grid& g, int o, CellRuns& out) {
+  // Sub-cell coordinate of the octant relative to the parent block's lowest sub-cell (2 = own
+  // cell's lower half): s = 2 + bit, neighbours s − 1 … s + 1.
+  const int sx = 2 + (o & 1), sy = 2 + ((o >> 1) & 1), sz = 2 + ((o >> 2) & 1);
+  int m = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int ux = sx + dx, uy = sy + dy, uz = sz + dz;  // in [1, 4]
+        const uint32_t p = out.parent[((uz >> 1) * 3 + (uy >> 1)) * 3 + (ux >> 1)];
+        if (p == kNoSlot) continue;
+        const uint32_t so = static_cast<uint32_t>((ux & 1) | (uy & 1) << 1 | (uz & 1) << 2);
+        const Run r{g.sub_begin[8 * size_t{p} + so], g.sub_begin[8 * size_t{p} + so + 1]};
+        if (r.begin == r.end) continue;
+        if (m > 0 && out.runs[o][m - 1].end == r.begin)
+          out.runs[o][m - 1].end = r.end;
+        else
+          out.runs[o][m++] = r;
+      }
+  out.count[o] = static_cast<uint8_t>(m);
+}
+
+// Block runs of octant o: the 2×2×2 block of cells toward which the octant lies, sorted by
+// first slot, touching runs merged.
+void block_octant(int o, CellRuns& out) {
+  const int bx = o & 1, by = (o >> 1) & 1, bz = (o >> 2) & 1;
+  Run tmp[8];
+  int n = 0;
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx) {
+        const Run r = out.block[((bz + dz) * 3 + by + dy) * 3 + bx + dx];
+        if (r.begin == r.end) continue;
+        int k = n++;
+        while (k > 0 && tmp[k - 1].begin > r.begin) {  // insertion sort by begin
+          tmp[k] = tmp[k - 1];
+          --k;
         }
-    out.count[o] = static_cast<uint8_t>(m);
+        tmp[k] = r;
+      }
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    if (m > 0 && out.runs[o][m - 1].end == tmp[i].begin)
+      out.runs[o][m - 1].end = tmp[i].end;  // touching runs: one scan
+    else
+      out.runs[o][m++] = tmp[i];
   }
+  out.count[o] = static_cast<uint8_t>(m);
 }
 
 }  // namespace
 
-void cell_runs(const Grid& g, uint32_t cell, CellRuns& out) {
+void cell_neighbourhood(const Grid& g, uint32_t cell, CellRuns& out) {
   const std::array<uint32_t, 3> c = g.coord[g.cell_begin[cell]];
-  if (!g.sub_begin.empty()) {
-    subcell_runs(g, c, out);
+  out.ready = 0;
+  out.subcells = !g.sub_begin.empty();
+  if (out.subcells) {
+    subcell_parents(g, c, out);
     return;
   }
-  Run r27[3][3][3];
   for (int dz = 0; dz < 3; ++dz)
     for (int dy = 0; dy < 3; ++dy)
       for (int dx = 0; dx < 3; ++dx)
-        r27[dz][dy][dx] =
+        out.block[(dz * 3 + dy) * 3 + dx] =
             cell_range(g, int64_t{c[0]} + dx - 1, int64_t{c[1]} + dy - 1, int64_t{c[2]} + dz - 1);
-  for (int o = 0; o < 8; ++o) {
-    const int bx = o & 1, by = (o >> 1) & 1, bz = (o >> 2) & 1;
-    Run tmp[8];
-    int n = 0;
-    for (int dz = 0; dz < 2; ++dz)
-      for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx) {
-          const Run r = r27[bz + dz][by + dy][bx + dx];
-          if (r.begin == r.end) continue;
-          int k = n++;
-          while (k > 0 && tmp[k - 1].begin > r.begin) {  // insertion sort by begin
-            tmp[k] = tmp[k - 1];
-            --k;
-          }
-          tmp[k] = r;
-        }
-    int m = 0;
-    for (int i = 0; i < n; ++i) {
-      if (m > 0 && out.runs[o][m - 1].end == tmp[i].begin)
-        out.runs[o][m - 1].end = tmp[i].end;  // touching runs: one scan
-      else
-        out.runs[o][m++] = tmp[i];
-    }
-    out.count[o] = static_cast<uint8_t>(m);
-  }
+}
+
+void octant_runs(const Grid& g, int o, CellRuns& out) {
+  if (out.ready & (1u << o)) return;
+  if (out.subcells)
+    subcell_octant(g, o, out);
+  else
+    block_octant(o, out);
+  out.ready = static_cast<uint8_t>(out.ready | (1u << o));
+}
+
+void cell_runs(const Grid& g, uint32_t cell, CellRuns& out) {
+  cell_neighbourhood(g, cell, out);
+  for (int o = 0; o < 8; ++o) octant_runs(g, o, out);
 }
 
 }  // namespace phaco::sph

@@ -139,13 +139,24 @@ Run cell_range(const Grid& grid, int64_t ix, int64_t iy, int64_t iz);
 // UnsortedHash: the range of `items` listing the cell's slots (empty when it has none).
 Run hash_cell(const Grid& grid, int64_t ix, int64_t iy, int64_t iz);
 
-// The candidate runs of every octant of one cell (sorted orders), computed once per cell.
-// With subcells: the runs of the 27 sub-cells of edge h around the octant's sub-cell.
+// The candidate runs of the octants of one cell (sorted orders). With subcells: the runs of the
+// 27 sub-cells of edge h around the octant's sub-cell; else of the 2×2×2 block of cells.
+// Computed lazily: the cell's 27 neighbours once (cell_neighbourhood), then each octant's runs
+// the first time a particle of that octant asks (octant_runs). A cell of a sparse subset (the
+// boundary cells of fragments in contact) holds a few particles in a few octants, and building
+// all eight octants for them dominated the contact pass.
 inline constexpr int kMaxRuns = 27;
 struct CellRuns {
   std::array<std::array<Run, kMaxRuns>, 8> runs;  // [octant][run]
   std::array<uint8_t, 8> count{};                 // runs per octant
+  std::array<uint32_t, 27> parent{};  // sub-cell grids: the 27 neighbouring cells, kNoSlot empty
+  std::array<Run, 27> block{};        // block grids: the 27 neighbouring cells' slot ranges
+  uint8_t ready = 0;                  // bit o: runs[o] and count[o] are computed
+  bool subcells = false;
 };
+void cell_neighbourhood(const Grid& grid, uint32_t cell, CellRuns& out);
+void octant_runs(const Grid& grid, int octant, CellRuns& out);
+// Both of the above for all eight octants.
 void cell_runs(const Grid& grid, uint32_t cell, CellRuns& out);
 
 }  // namespace phaco::sph

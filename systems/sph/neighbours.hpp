@@ -22,7 +22,8 @@
 namespace phaco::sph {
 
 // The candidate runs of slots visited in increasing order (sorted orders): the octant's runs of
-// the 2×2×2 block, computed once per cell (cell_runs) and shared by the cell's particles.
+// the 2×2×2 block (or its 27 sub-cells), the cell's neighbourhood found once per cell and each
+// octant's runs once, shared by the cell's particles.
 class Candidates {
  public:
   explicit Candidates(const Grid& g) : g_(g) {}
@@ -31,9 +32,10 @@ class Candidates {
   std::span<const Run> runs(uint32_t i) {
     if (g_.slot_cell[i] != cell_) {
       cell_ = g_.slot_cell[i];
-      cell_runs(g_, cell_, cell_runs_);
+      cell_neighbourhood(g_, cell_, cell_runs_);
     }
     const uint8_t o = g_.octant[i];
+    if (!(cell_runs_.ready & (1u << o))) octant_runs(g_, o, cell_runs_);
     return {cell_runs_.runs[o].data(), cell_runs_.count[o]};
   }
 
