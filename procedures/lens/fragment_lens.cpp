@@ -89,8 +89,11 @@ void remove_lens_cells(FragmentLens& l, std::span<const uint32_t> cells, Fragmen
   l.awake = true;
   l.removals.clear();
   for (uint32_t c : cells) {
-    const simplex::Removal r = simplex::remove_cell(l.cells, c);
+    simplex::Removal r = simplex::remove_cell(l.cells, c);
     if (!r.removed) continue;
+    // Right after each removal (not after the batch): a split needs one removal whose neighbours
+    // it leaves apart, and only the state right after that removal shows it.
+    if (r.may_split) simplex::confirm_split(l.cells, r, l.fragment_scratch);
     l.removals.push_back(r);
     l.volume_removed_mm3 += l.cells.volume[c];
   }

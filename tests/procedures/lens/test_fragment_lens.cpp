@@ -62,6 +62,12 @@ TEST(FragmentLens, ACutThroughTheLensMakesRigidFragmentsThatStayInsideAndApart) 
   FragmentLens l = cut_in_two();
   EXPECT_GT(l.cells_removed, 50u);
   ASSERT_GE(l.fragments.count, 2u);
+  // The labels kept up removal by removal (splits confirmed locally) are a fresh painting's.
+  Fragments fresh;
+  simplex::FragmentScratch scratch;
+  simplex::label_fragments_painting(l.cells, fresh, scratch);
+  EXPECT_EQ(l.fragments.label, fresh.label);
+  EXPECT_EQ(l.fragments.count, fresh.count);
   const uint32_t n = l.cells.size();
   for (uint32_t c = 0; c < n; ++c) {
     if (!l.cells.alive[c]) continue;
