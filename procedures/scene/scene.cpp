@@ -15,6 +15,7 @@
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
@@ -187,8 +188,10 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
                      .run = [&scene](const FrameContext& ctx) {
                        const double t_end = ctx.time_s + ctx.dt_s;
                        for (Entity e : scene.tools) {
-                         tool_motion::move_tool(scene.world.at<ToolTrack>(e),
-                                                scene.world.at<ToolState>(e), t_end);
+                         // A device replaces the track of its hand (DESIGN.md §7).
+                         ToolState& pose = scene.world.at<ToolState>(e);
+                         if (scene.haptics && scene.haptics->newest_pose(scene.world.at<Tool>(e).hand, pose)) continue;
+                         tool_motion::move_tool(scene.world.at<ToolTrack>(e), pose, t_end);
                        }
                      }});
   // The frame's one sync point for structural change (DESIGN.md §4, step 3).
@@ -227,6 +230,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   scene->params = load_params(scenario);
   scene->resolution = eye::resolution_for_level(scenario.eye.level);
   scene->commands = CommandQueues(options.threads);
+  scene->haptics = options.haptics;
 
   const auto parts = bodies_for(scenario.drill);
   check_methods(scenario, parts);
@@ -264,6 +268,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
       systems.push_back(lens_sculpt_system(*scene));
     }
   }
+  if (scene->haptics) systems.push_back(haptic_publish_system(*scene));
   if (options.extra_systems) {
     for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));
   }

@@ -22,6 +22,7 @@
 #include "engine/schedule/frame_graph.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/eye/resolution.hpp"
+#include "procedures/scene/haptic_port.hpp"
 
 namespace phaco {
 
@@ -32,6 +33,9 @@ struct SceneOptions {
   std::optional<std::filesystem::path> cache_dir;  // default: MeshCache::default_dir()
   // Extra systems (tests, tools): called once the bodies exist, before the graph is built.
   std::function<std::vector<SystemDesc>(Scene&)> extra_systems;
+  // A haptic runtime (issue 6): device-driven hands take their pose from it, and the frame ends by
+  // publishing the local haptic model to it. Null: every hand follows its track, nothing published.
+  HapticPort* haptics = nullptr;
 };
 
 struct Scene {
@@ -47,6 +51,7 @@ struct Scene {
   uint64_t frame = 0;
   double time_s = 0;
   double mesh_load_s = 0;  // wall time to load or build the meshes
+  HapticPort* haptics = nullptr;  // from SceneOptions
 
   std::optional<Entity> body(BodyPart part) const;
 };

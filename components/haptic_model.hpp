@@ -1,0 +1,78 @@
+#pragma once
+// What the 1 kHz haptic thread needs to compute force alone (DESIGN.md §5, seed 003 §III.C–E):
+// per tool, a small local model published once per simulation frame through a triple buffer.
+//
+//   nodes     the active node set near the tool (seed 003: the k-hop set, a few hundred nodes)
+//             plus the ring of anchored nodes that holds it, with their springs; integrated by
+//             the haptic thread between frames
+//   patch     surface triangles near the tool, corners given as node indices, so a proxy
+//             (god-object) can be kept outside them and the triangles move with the nodes
+//   grasp     the node the forceps hold, if any: it follows the tool proxy, and the user feels
+//             the springs pulling it back (the flap's spring)
+//   lens      the lens's shape near the tool, for seed 003's F = −k_f·d (penetration depth)
+//
+// Fixed capacity so that a copy into the triple buffer never allocates (≈ 31 KiB per tool).
+// Plain data only; systems/haptic_model computes the force, procedures/scene fills it.
+#include <array>
+#include <cstdint>
+
+namespace phaco {
+
+inline constexpr uint32_t kHapticTools = 2;           // one per hand
+inline constexpr uint32_t kHapticMaxNodes = 384;      // active set (≈ 121 for k = 5) + anchors
+inline constexpr uint32_t kHapticMaxSprings = 1536;   // ≈ 4 per node on the capsule's grids
+inline constexpr uint32_t kHapticMaxTriangles = 256;  // contact patch
+inline constexpr uint16_t kHapticNoNode = 0xFFFF;
+
+// Free nodes move under their springs; anchored ones hold still (outside the active set, or on a
+// rigid body such as the cornea); the grasped one follows the tool proxy.
+enum class HapticNodeKind : uint8_t { Free = 0, Anchored = 1, Grasped = 2 };
+
+struct HapticTool {
+  bool present = false;   // false: no tool in this hand, or nothing near it; force is zero
+  uint8_t tool_kind = 0;  // phaco::ToolKind as a number (kept plain so this header needs no io)
+  uint8_t hand = 0;       // phaco::Hand
+  float tip_radius_mm = 0.15f;
+  std::array<float, 3> tip_mm{};  // tool tip where the simulation had it at publish, mm
+
+  // Local nodes (positions and velocities at publish).
+  uint32_t node_count = 0;
+  std::array<float, kHapticMaxNodes> x{}, y{}, z{};     // mm
+  std::array<float, kHapticMaxNodes> vx{}, vy{}, vz{};  // mm/s
+  std::array<float, kHapticMaxNodes> mass{};            // kg
+  std::array<HapticNodeKind, kHapticMaxNodes> kind{};
+
+  // Springs between local nodes (Hooke, seed 003 §E.1: f = −k·dx).
+  uint32_t spring_count = 0;
+  std::array<uint16_t, kHapticMaxSprings> spring_i{}, spring_j{};
+  std::array<float, kHapticMaxSprings> rest_mm{};
+  std::array<float, kHapticMaxSprings> k_mn_per_mm{};
+  // Seed 003 §E.2–3: damping and viscoelastic (viscoelastic device, OVD) forces, −(k_d + k_v)·v.
+  float damping_mn_s_per_mm = 0;
+
+  uint16_t grasped_node = kHapticNoNode;  // local index, or none
+
+  // Contact patch: triangles near the tool (corners are local node indices).
+  uint32_t triangle_count = 0;
+  std::array<std::array<uint16_t, 3>, kHapticMaxTriangles> triangles{};
+  float patch_stiffness_mn_per_mm = 0;  // of the proxy–surface contact
+
+  // Lens: two half-ellipsoids about `lens_centre_mm` (DESIGN.md §6), rotated by nothing (the
+  // lens is axially symmetric about +z). Seed 003 §E.5: F = −k_f·d, d the penetration depth.
+  bool lens_present = false;
+  std::array<float, 3> lens_centre_mm{};
+  float lens_equator_radius_mm = 4.7f;
+  float lens_anterior_mm = 1.8f;   // half-thickness toward +z
+  float lens_posterior_mm = 2.7f;  // half-thickness toward −z
+  float lens_stiffness_mn_per_mm = 0;
+};
+
+struct HapticModel {
+  uint64_t sequence = 0;     // increases by one per publish; 0 = nothing published yet
+  uint64_t frame = 0;        // simulation frame it was built from
+  double sim_time_s = 0;     // s
+  int64_t published_ns = 0;  // steady clock (engine/core/clock.hpp now_ns) at publish
+  std::array<HapticTool, kHapticTools> tools{};
+};
+
+}  // namespace phaco

@@ -1,0 +1,60 @@
+#pragma once
+// Publish phase, haptic half (DESIGN.md §4 step 5, §5): per tool, the small local model the 1 kHz
+// haptic thread computes force from between frames (components/haptic_model.hpp).
+//
+//   nodes    seed 003 §III.D: the capsule particles within k hops (haptic_model.active_hops, the
+//            seed's k = 5) of what the tool holds or touches — the grasped particle, else the
+//            capsule particle nearest the tip within haptic_model.contact_radius_mm — free, and
+//            the next ring anchored so the set is held as the full mesh holds it. When the ball
+//            would overflow the model's capacity, its last layer becomes the anchored ring.
+//   springs  every capsule spring between two local nodes (Hooke; the scene's rest lengths, which
+//            carry the pretension, and stiffnesses)
+//   patch    capsule triangles whose three corners are local, nearest the tip first
+//   lens     the standard lens's two half-ellipsoids for seed 003 §E.5's F = −k_f·d; left out for
+//            the phaco probe in the sculpting scene, which goes into the lens on purpose (the
+//            resistance of the nucleus to the probe is not modelled)
+//
+// Cost: a scan of the capsule's particles and triangles per tool (≈ 8k and 16k at level 3), a
+// breadth-first walk of the ball, and a ≈ 62 KiB model write. Reads: tools.pose, tools.grasp,
+// capsule.particles, capsule.physics, capsule.triangles. Writes: haptics.model.
+#include <cstdint>
+#include <vector>
+
+#include "components/haptic_model.hpp"
+#include "engine/schedule/system.hpp"
+
+namespace phaco {
+
+struct Scene;
+
+struct HapticPublishSettings {
+  uint32_t active_hops = 5;           // seed 003 §III.D
+  double contact_radius_mm = 1.0;     // a tool this near the capsule takes a local model of it
+  double lens_stiffness_mn_mm = 100;  // seed 003 §E.5 k_f
+  double patch_stiffness_mn_mm = 200;
+};
+
+// Scratch kept between frames so that publishing does not allocate once warm.
+struct HapticPublishScratch {
+  uint64_t published = 0;       // models built so far: the next one's sequence number
+  std::vector<uint16_t> local;  // per capsule particle: its local index, or kHapticNoNode
+  std::vector<uint32_t> nodes;  // local → capsule particle
+  std::vector<uint32_t> layer, next;
+  std::vector<std::pair<float, uint32_t>> near_triangles;  // squared distance to the tip, triangle
+};
+
+// The settings from the eye parameters' haptic_model section.
+HapticPublishSettings haptic_publish_settings(const Scene& scene);
+
+// Fills `model` from the scene as it is now (after the frame's dynamics). Every field of every
+// tool is rewritten; `sequence`, `frame`, `sim_time_s` and `published_ns` are set too.
+void build_haptic_model(const Scene& scene, const HapticPublishSettings& settings,
+                        HapticPublishScratch& scratch, HapticModel& model);
+
+// The frame's system: builds into scene.haptics->model_slot() and publishes it.
+SystemDesc haptic_publish_system(Scene& scene);
+
+// Radius of a tool's tip as the haptic model sees it, mm (from the eye's `tools` section).
+double haptic_tip_radius_mm(const Scene& scene, uint8_t tool_kind);
+
+}  // namespace phaco

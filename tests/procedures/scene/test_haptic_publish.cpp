@@ -1,0 +1,191 @@
+// The publish side of the haptic handoff (procedures/scene/haptic_publish): the local model the
+// 1 kHz thread gets must be the capsule as the simulation has it near the tool — every free node
+// with all of its springs (so the local forces on it are the full mesh's), held by an anchored
+// ring — and must follow the tools (grasp, distance, lens).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "components/particles.hpp"
+#include "components/tool.hpp"
+#include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/haptic_publish.hpp"
+#include "procedures/scene/scene.hpp"
+#include "tests/support/scene_run.hpp"
+
+namespace phaco {
+namespace {
+
+// A haptic runtime stand-in: no device, keeps the last published model.
+class CapturePort final : public HapticPort {
+ public:
+  bool newest_pose(Hand, ToolPose&) override { return false; }
+  HapticModel& model_slot() override { return slot; }
+  void publish_model() override { ++published, last_sequence = slot.sequence; }
+  HapticModel slot;
+  uint64_t published = 0, last_sequence = 0;
+};
+
+std::unique_ptr<Scene> scene_at(const char* scenario, double t_s, CapturePort& port) {
+  const Scenario s = test::repo_scenario(scenario);
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  o.haptics = &port;
+  auto scene = build_scene(s, o);
+  const auto frames = static_cast<uint64_t>(std::llround(t_s / s.dt_s));
+  for (uint64_t f = 0; f < frames; ++f) step(*scene);
+  return scene;
+}
+
+const HapticTool& tool_in(const HapticModel& m, Hand hand) {
+  return m.tools[static_cast<size_t>(hand)];
+}
+
+TEST(HapticPublish, TheGraspedFlapComesWithItsWholeNeighbourhood) {
+  CapturePort port;
+  // At 4.0 s the demo's forceps (left hand) hold the flap and pull it round.
+  auto scene = scene_at("capsulorhexis_demo.json", 4.0, port);
+  EXPECT_EQ(port.published, scene->frame) << "one model per frame";
+  EXPECT_EQ(port.last_sequence, scene->frame) << "sequence numbers count the publishes";
+
+  const HapticTool& t = tool_in(port.slot, Hand::Left);
+  ASSERT_TRUE(t.present);
+  EXPECT_EQ(t.tool_kind, static_cast<uint8_t>(ToolKind::Forceps));
+  ASSERT_NE(t.grasped_node, kHapticNoNode) << "the forceps hold the flap at 4 s";
+  EXPECT_EQ(t.kind[t.grasped_node], HapticNodeKind::Grasped);
+  ASSERT_GT(t.node_count, 20u);
+  ASSERT_LE(t.node_count, kHapticMaxNodes);
+  EXPECT_GT(t.spring_count, t.node_count) << "a membrane has more springs than nodes";
+  EXPECT_GT(t.triangle_count, 0u);
+  EXPECT_GT(t.damping_mn_s_per_mm, 0.0f);
+
+  const Entity capsule = *scene->body(BodyPart::Capsule);
+  const Particles& p = scene->world.at<Particles>(capsule);
+  const CapsulePhysics& cp = scene->world.at<CapsulePhysics>(capsule);
+  const auto& g = scene->world.at<ToolGrasp>(scene->tools[0]);
+  ASSERT_TRUE(g.capsule.holding());
+
+  // Map local nodes back to particles by position (the model carries no global index).
+  std::vector<uint32_t> particle_of(t.node_count, kInvalidIndex);
+  for (uint32_t l = 0; l < t.node_count; ++l) {
+    for (uint32_t i = 0; i < p.slots.size(); ++i) {
+      if (p.slots.alive(i) && p.x[i] == t.x[l] && p.y[i] == t.y[l] && p.z[i] == t.z[l]) {
+        particle_of[l] = i;
+        break;
+      }
+    }
+    ASSERT_NE(particle_of[l], kInvalidIndex) << "node " << l << " is a capsule particle";
+    const float inv = p.inv_mass[particle_of[l]];
+    EXPECT_FLOAT_EQ(t.mass[l], inv > 0 ? 1.0f / inv : 0.0f);
+  }
+  EXPECT_EQ(particle_of[t.grasped_node], g.capsule.particle);
+
+  // Every free node carries all of its springs, with the scene's rest length and stiffness.
+  uint32_t free_nodes = 0;
+  for (uint32_t l = 0; l < t.node_count; ++l) {
+    if (t.kind[l] != HapticNodeKind::Free) continue;
+    ++free_nodes;
+    const uint32_t i = particle_of[l];
+    std::multiset<std::pair<float, float>> scene_springs, model_springs;
+    for (uint32_t k = cp.graph.offset[i]; k < cp.graph.offset[i + 1]; ++k) {
+      const uint32_t sp = cp.graph.spring[k];
+      scene_springs.insert({cp.springs.rest_length[sp], cp.springs.stiffness[sp]});
+    }
+    for (uint32_t s = 0; s < t.spring_count; ++s) {
+      if (t.spring_i[s] == l || t.spring_j[s] == l)
+        model_springs.insert({t.rest_mm[s], t.k_mn_per_mm[s]});
+    }
+    EXPECT_EQ(scene_springs, model_springs) << "free node " << l << " (particle " << i << ")";
+  }
+  EXPECT_GT(free_nodes, 10u);
+  for (uint32_t s = 0; s < t.spring_count; ++s) {
+    ASSERT_LT(t.spring_i[s], t.node_count);
+    ASSERT_LT(t.spring_j[s], t.node_count);
+    EXPECT_FALSE(t.kind[t.spring_i[s]] == HapticNodeKind::Anchored &&
+                 t.kind[t.spring_j[s]] == HapticNodeKind::Anchored)
+        << "a spring between two anchors does nothing";
+  }
+  for (uint32_t f = 0; f < t.triangle_count; ++f) {
+    for (uint16_t c : t.triangles[f]) EXPECT_LT(c, t.node_count);
+  }
+  EXPECT_TRUE(t.lens_present) << "the rhexis scene has the lens under the capsule";
+  EXPECT_GT(t.lens_stiffness_mn_per_mm, 0.0f);
+}
+
+TEST(HapticPublish, ATipFarFromTheCapsuleGetsNoNodes) {
+  CapturePort port;
+  // At the start the cystotome (right hand) waits at z = 3.5, 1.7 mm above the capsule.
+  auto scene = scene_at("capsulorhexis_demo.json", 1.0 / 60.0, port);
+  const HapticTool& t = tool_in(port.slot, Hand::Right);
+  ASSERT_TRUE(t.present);
+  EXPECT_EQ(t.tool_kind, static_cast<uint8_t>(ToolKind::Cystotome));
+  EXPECT_EQ(t.node_count, 0u);
+  EXPECT_EQ(t.spring_count, 0u);
+  EXPECT_EQ(t.triangle_count, 0u);
+  EXPECT_EQ(t.grasped_node, kHapticNoNode);
+  const ToolState& pose = scene->world.at<ToolState>(scene->tools[1]);
+  EXPECT_EQ(t.tip_mm[2], static_cast<float>(pose.pos.z())) << "the tip where the simulation has it";
+  EXPECT_GT(t.tip_mm[2], 3.0f);
+}
+
+TEST(HapticPublish, TheBallGrowsWithTheHopsAndStaysWithinCapacity) {
+  CapturePort port;
+  auto scene = scene_at("capsulorhexis_demo.json", 4.0, port);
+  HapticPublishScratch scratch;
+  HapticModel m;
+  uint32_t previous = 0;
+  for (uint32_t hops : {1u, 3u, 5u, 8u, 20u}) {
+    HapticPublishSettings s = haptic_publish_settings(*scene);
+    s.active_hops = hops;
+    build_haptic_model(*scene, s, scratch, m);
+    const HapticTool& t = tool_in(m, Hand::Left);
+    EXPECT_GE(t.node_count, previous) << hops << " hops";
+    EXPECT_LE(t.node_count, kHapticMaxNodes);
+    EXPECT_LE(t.spring_count, kHapticMaxSprings);
+    previous = t.node_count;
+  }
+  // 20 hops would take the whole flap: the ball stops a layer early, that layer anchored, so
+  // the model nearly fills its capacity and every free node still has its springs (below).
+  EXPECT_GT(previous, kHapticMaxNodes * 3 / 4) << "20 hops fill the model to near capacity";
+  {
+    const HapticTool& t = tool_in(m, Hand::Left);
+    std::vector<uint32_t> degree(t.node_count, 0);
+    for (uint32_t s = 0; s < t.spring_count; ++s) ++degree[t.spring_i[s]], ++degree[t.spring_j[s]];
+    uint32_t anchored = 0;
+    for (uint32_t l = 0; l < t.node_count; ++l) {
+      if (t.kind[l] == HapticNodeKind::Anchored) ++anchored;
+      else EXPECT_GE(degree[l], 2u) << "a free node held by its springs";
+    }
+    EXPECT_GT(anchored, 0u) << "the outer layer holds the ball";
+  }
+  // The scratch marks are cleared after each build: a second build gives the same model.
+  HapticModel again;
+  HapticPublishSettings s = haptic_publish_settings(*scene);
+  build_haptic_model(*scene, s, scratch, m);
+  build_haptic_model(*scene, s, scratch, again);
+  const HapticTool &a = tool_in(m, Hand::Left), &b = tool_in(again, Hand::Left);
+  ASSERT_EQ(a.node_count, b.node_count);
+  ASSERT_EQ(a.spring_count, b.spring_count);
+  for (uint32_t l = 0; l < a.node_count; ++l) EXPECT_EQ(a.x[l], b.x[l]);
+}
+
+TEST(HapticPublish, TheSculptingProbeFeelsNoLensButTheScenesOtherToolsDo) {
+  CapturePort port;
+  auto scene = scene_at("phaco_sculpting_demo.json", 1.0 / 60.0, port);
+  bool saw_probe = false;
+  for (const HapticTool& t : port.slot.tools) {
+    if (!t.present) continue;
+    if (t.tool_kind == static_cast<uint8_t>(ToolKind::PhacoProbe)) {
+      saw_probe = true;
+      EXPECT_FALSE(t.lens_present) << "the probe sculpts the lens on purpose";
+      EXPECT_NEAR(t.tip_radius_mm, 0.45f, 1e-6);
+    } else {
+      EXPECT_TRUE(t.lens_present);
+    }
+  }
+  EXPECT_TRUE(saw_probe);
+}
+
+}  // namespace
+}  // namespace phaco
