@@ -56,8 +56,15 @@ studies:
       fragments, float vs double, cost per fragment, the whole-lens pass); the SPH neighbour search at
       10k, 100k and 1M particles (quick 10k; --no-million skips 1M) per cell order; the lens tools;
       the fragmenting lens per frame; the divide-and-conquer demo per level.
+  haptics
+      Issue 6, the 1 kHz haptic thread: beside the capsulorhexis scene in real time (60 s each, quick
+      5 s) with and without real-time priority, models at 30 Hz, a 200 ms simulation stall: period,
+      lateness, compute, sample-to-force latency, allocations on the haptic thread, force continuity;
+      the loop alone with a busy second core; the local model's passive stiffness against the rate
+      (Colgate's bound), continuity with and without the crossfade, tick cost per node count; the UDP
+      bridge's round trip and silence-to-zero-force. About 4 minutes (quick about 30 s).
   all
-      foundation, bandwidth, membrane, cut, lens.
+      foundation, bandwidth, membrane, cut, lens, haptics.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -96,6 +103,8 @@ int main(int argc, char** argv) {
       perf::run_cut(options);
     } else if (cmd == "lens") {
       perf::run_lens(options);
+    } else if (cmd == "haptics") {
+      perf::run_haptics(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");
@@ -104,6 +113,7 @@ int main(int argc, char** argv) {
       perf::run_membrane(options);
       perf::run_cut(options);
       perf::run_lens(options);
+      perf::run_haptics(options);
     } else {
       std::fprintf(stderr, "phaco-perf: unknown study '%s' (try --help)\n", cmd.c_str());
       return 2;

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The README's second command (and what .ci/run calls): installs what is needed, builds, and
 # runs every test; then builds the ASan+UBSan configuration and runs every test again under it
-# (skip that with PHACO_SKIP_SANITIZERS=1 for a quick local run). TSan is a preset but not run
-# here: Debian's libtbb is not instrumented, so TSan reports oneTBB's own hand-offs as races.
+# (skip that with PHACO_SKIP_SANITIZERS=1 for a quick local run), and the haptic tests (the 1 kHz
+# loop, the lock-free handoff, the devices, the session) under ThreadSanitizer. TSan runs only those:
+# Debian's libtbb is not instrumented, so TSan would report oneTBB's own hand-offs as races, and
+# the haptic path is built without oneTBB.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 jobs="${PHACO_JOBS:-$(nproc)}"
@@ -24,4 +26,18 @@ if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   # Only what the tests run (every test executable and the phaco CLI), not the perf harness.
   cmake --build "$asan" -j "$jobs" --target phaco_tests
   PHACO_CACHE_DIR="$asan/mesh-cache" ctest --test-dir "$asan" --output-on-failure -j "$jobs"
+fi
+
+if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
+  tsan="$root/build/tsan"
+  cmake -S "$root" -B "$tsan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHACO_SANITIZE=thread \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+    -DPHACO_BUILD_BENCHMARKS=OFF >/dev/null
+  haptic_tests=(engine/haptics/test_haptic_loop engine/haptics_devices/test_haptics_devices
+                procedures/haptics/test_haptic_session)
+  cmake --build "$tsan" -j "$jobs" --target "${haptic_tests[@]##*/}"
+  # halt_on_error: a reported race fails the run (TSan otherwise only sets the exit code at exit).
+  for t in "${haptic_tests[@]}"; do
+    TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" "$tsan/tests/$t"
+  done
 fi

@@ -8,9 +8,11 @@
 
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
+#include "engine/haptics/device_factory.hpp"
 #include "engine/io/scenario.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
+#include "procedures/haptics/realtime_run.hpp"
 #include "procedures/scene/run.hpp"
 
 namespace phaco::cli {
@@ -53,11 +55,23 @@ Args parse(const std::string& command, const std::vector<std::string>& raw,
   return a;
 }
 
-int parse_int(const std::string& command, const std::string& option, const std::string& text, int lo, int hi) {
+int parse_int(const std::string& command, const std::string& option, const std::string& text,
+              int lo, int hi) {
   int value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec != std::errc{} || end != text.data() + text.size() || value < lo || value > hi) {
-    throw InputError(command + ": " + option + " expects an integer in " + std::to_string(lo) + ".." +
+    throw InputError(command + ": " + option + " expects an integer in " + std::to_string(lo) +
+                     ".." + std::to_string(hi) + ", got '" + text + "'");
+  }
+  return value;
+}
+
+double parse_seconds(const std::string& command, const std::string& option, const std::string& text,
+                     double lo, double hi) {
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc{} || end != text.data() + text.size() || !(value >= lo && value <= hi)) {
+    throw InputError(command + ": " + option + " expects a number in " + std::to_string(lo) + ".." +
                      std::to_string(hi) + ", got '" + text + "'");
   }
   return value;
@@ -99,15 +113,19 @@ int validate(const std::vector<std::string>& raw) {
 
 int mesh(const std::vector<std::string>& raw) {
   const Args a = parse("mesh", raw, {"--level", "--out", "--layout", "--params"}, {"--no-tets"});
-  if (!a.positional.empty()) throw InputError("mesh: unexpected argument '" + a.positional[0] + "'");
+  if (!a.positional.empty())
+    throw InputError("mesh: unexpected argument '" + a.positional[0] + "'");
   const auto out = a.option("--out");
   if (!out) throw InputError("mesh: --out DIR is required");
-  const int level = parse_int("mesh", "--level", a.option("--level").value_or("3"), eye::kMinLevel, eye::kMaxLevel);
+  const int level = parse_int("mesh", "--level", a.option("--level").value_or("3"), eye::kMinLevel,
+                              eye::kMaxLevel);
   const std::string layout_name = a.option("--layout").value_or("curvilinear");
   if (layout_name != "curvilinear" && layout_name != "isotropic") {
-    throw InputError("mesh: --layout expects 'curvilinear' or 'isotropic', got '" + layout_name + "'");
+    throw InputError("mesh: --layout expects 'curvilinear' or 'isotropic', got '" + layout_name +
+                     "'");
   }
-  const auto layout = layout_name == "isotropic" ? eye::CapsuleLayout::Isotropic : eye::CapsuleLayout::Curvilinear;
+  const auto layout =
+      layout_name == "isotropic" ? eye::CapsuleLayout::Isotropic : eye::CapsuleLayout::Curvilinear;
   const eye::EyeParams params = a.option("--params") ? eye::load_eye_params(*a.option("--params"))
                                                      : eye::default_eye_params();
   const eye::Resolution res = eye::resolution_for_level(level);
@@ -134,7 +152,8 @@ int mesh(const std::vector<std::string>& raw) {
 
   std::printf("level %d (%s capsule) -> %s\n", level, layout_name.c_str(), out->c_str());
   auto row = [](const char* name, const SurfaceMesh& s) {
-    std::printf("  %-13s %8zu vertices %8zu triangles\n", name, s.vertices.size(), s.triangles.size());
+    std::printf("  %-13s %8zu vertices %8zu triangles\n", name, s.vertices.size(),
+                s.triangles.size());
   };
   row("cornea", m.cornea);
   row("capsule", m.capsule);
@@ -142,16 +161,66 @@ int mesh(const std::vector<std::string>& raw) {
   row("globe", m.globe);
   row("lens_surface", m.lens_surface);
   if (m.lens_tets) {
-    std::printf("  %-13s %8zu vertices %8zu tets\n", "lens", m.lens_tets->vertices.size(), m.lens_tets->tets.size());
+    std::printf("  %-13s %8zu vertices %8zu tets\n", "lens", m.lens_tets->vertices.size(),
+                m.lens_tets->tets.size());
   }
   std::printf("generated surfaces in %.3f s, tets in %.3f s\n", surfaces_s, tets_s);
   return kOk;
 }
 
+// `run --haptics SPEC`: the scene in real time with the 1 kHz haptic thread, a device in one hand.
+int run_with_haptics(const Args& a, const Scenario& scenario, const std::string& spec_text) {
+  const DeviceSpec spec = parse_device_spec(spec_text);
+  Hand hand = spec.hand.value_or(Hand::Right);
+  if (auto h = a.option("--hand")) {
+    const auto parsed = parse_hand(*h);
+    if (!parsed) throw InputError("run: --hand expects 'left' or 'right', got '" + *h + "'");
+    hand = *parsed;
+  }
+  DeviceContext context;
+  context.scenario = &scenario;
+  context.hand = hand;
+  HapticSessionConfig config;
+  config.loop.realtime = !a.flag("--no-rt");
+  config.loop.lock_memory = config.loop.realtime;
+  HapticSession session(config);
+  session.attach(hand, make_device(spec, context));
+  RealtimeRunOptions run;
+  if (auto d = a.option("--duration"))
+    run.duration_s = parse_seconds("run", "--duration", *d, 0.01, 86400);
+  if (auto t = a.option("--stall-at"))
+    run.stall_at_s = parse_seconds("run", "--stall-at", *t, 0, 86400);
+  if (auto m = a.option("--stall-ms"))
+    run.stall_ms = parse_seconds("run", "--stall-ms", *m, 0, 60000);
+  const RealtimeRunReport report = run_realtime(scenario, scene_options(a, "run"), session, run);
+  nlohmann::json j = to_json(report);
+  j["scenario"] = scenario.source;
+  j["device"] = spec_text;
+  j["hand"] = std::string(to_string(hand));
+  if (auto path = a.option("--report")) write_text(*path, j.dump(2) + "\n");
+  if (a.flag("--json")) {
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("%s, %s hand on device '%s'\n", scenario.source.c_str(),
+                std::string(to_string(hand)).c_str(), spec_text.c_str());
+    std::fputs(summary_text(report).c_str(), stdout);
+    if (auto path = a.option("--report")) std::printf("report written to %s\n", path->c_str());
+  }
+  return kOk;
+}
+
 int run(const std::vector<std::string>& raw) {
-  const Args a = parse("run", raw, {"--threads", "--report", "--cache-dir"}, {"--json"});
+  const Args a = parse("run", raw,
+                       {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration",
+                        "--stall-at", "--stall-ms"},
+                       {"--json", "--no-rt"});
   if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
   const Scenario scenario = load_scenario(a.positional[0]);
+  if (auto spec = a.option("--haptics")) return run_with_haptics(a, scenario, *spec);
+  for (const char* o : {"--hand", "--duration", "--stall-at", "--stall-ms"}) {
+    if (a.option(o)) throw InputError(std::string("run: ") + o + " needs --haptics");
+  }
+  if (a.flag("--no-rt")) throw InputError("run: --no-rt needs --haptics");
   const RunReport report = run_scenario(scenario, scene_options(a, "run"));
   const nlohmann::json j = to_json(report);
   if (auto path = a.option("--report")) write_text(*path, j.dump(2) + "\n");

@@ -1,0 +1,145 @@
+#pragma once
+// A device driven by another process or machine over UDP (issue 6 item 4; seed 001 links its
+// tracking machine to the simulation machine the same way). Protocol: docs/udp_bridge_protocol.md
+// — fixed 68-byte little-endian packets: magic "PHDB", version 1, type, device id, u32 sequence
+// number, sender timestamp (µs), payload, CRC-32 (ISO-HDLC, our own table, no zlib).
+//
+//   peer ──pose packets──▶ [I/O thread: recvfrom, validate, count] ──seqlock──▶ read()      ┐
+//   peer ◀─force packets── [I/O thread: send on change]           ◀──seqlock── write_force() ┘
+//                                                                  haptic thread, 1 kHz
+//
+// The I/O thread owns the socket (poll with a 1 ms timeout); the haptic thread touches only
+// atomics: read/write_force/health make no system call other than the clock. The device is
+// bound to one configured peer (IPv4 address:port); anything else is dropped and counted.
+// Silence: no accepted packet for more than silence_timeout_ms → health() says Silent, read()
+// returns the last good pose (frozen) and force goes out as zero; seen by the haptic thread at
+// its next tick after the timeout. Good packets resume it (after a silence any sequence number is
+// accepted, so a restarted peer resynchronises).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "engine/haptics/device.hpp"
+
+namespace phaco {
+
+namespace udp_protocol {
+
+inline constexpr uint32_t kMagic = 0x42444850;  // bytes 'P' 'H' 'D' 'B' read as a LE u32
+inline constexpr uint16_t kVersion = 1;
+inline constexpr std::size_t kPacketSize = 68;
+using Packet = std::array<uint8_t, kPacketSize>;
+
+enum class MessageType : uint8_t { Pose = 1, Force = 2 };
+
+// Peer → device: one device sample.
+struct PoseMessage {
+  uint32_t device_id = 0;
+  uint32_t seq = 0;             // +1 per packet, wraps at 2^32
+  uint64_t sender_time_us = 0;  // µs, the sender's monotonic clock (any epoch)
+  std::array<float, 3> pos_mm{};
+  std::array<float, 4> quat{1, 0, 0, 0};  // w, x, y, z
+  float grip = 0;                         // 0..1
+  float pedal = 0;                        // 0..3
+  uint32_t buttons = 0;
+  bool operator==(const PoseMessage&) const = default;
+};
+
+// Device → peer: the force to render and which pose sample it was computed from.
+struct ForceMessage {
+  uint32_t device_id = 0;
+  uint32_t seq = 0;             // +1 per force packet
+  uint64_t sender_time_us = 0;  // µs, the device side's steady clock
+  std::array<float, 3> force_mn{};
+  uint32_t ack_seq = 0;             // seq of the newest pose the haptic thread had read
+  uint64_t ack_sender_time_us = 0;  // that pose's sender_time_us, echoed: peer-side latency
+  uint8_t health = 0;               // DeviceHealth
+  bool operator==(const ForceMessage&) const = default;
+};
+
+enum class DecodeStatus : uint8_t { Ok, Malformed, WrongVersion, BadChecksum, WrongType };
+
+// CRC-32/ISO-HDLC (the zlib/PNG/Ethernet CRC): reflected polynomial 0xEDB88320, init and final
+// xor 0xFFFFFFFF. "123456789" → 0xCBF43926.
+uint32_t crc32(std::span<const uint8_t> bytes);
+
+Packet encode(const PoseMessage& m);
+Packet encode(const ForceMessage& m);
+// Checks size, magic, version, CRC and type, in that order (the first failure is returned).
+DecodeStatus decode(std::span<const uint8_t> bytes, PoseMessage& out);
+DecodeStatus decode(std::span<const uint8_t> bytes, ForceMessage& out);
+
+}  // namespace udp_protocol
+
+struct UdpBridgeConfig {
+  std::string name = "udp";
+  std::string bind_host = "0.0.0.0";    // IPv4 address to listen on
+  uint16_t local_port = 0;              // 0: an ephemeral port (see local_port())
+  std::string peer_host = "127.0.0.1";  // IPv4 address or host name (resolved once, IPv4)
+  uint16_t peer_port = 0;
+  uint32_t device_id = 0;          // 0: accept any; else other ids count as wrong_peer
+  double silence_timeout_ms = 50;  // no accepted packet for longer → Silent
+  // A packet is stale when its one-way age exceeds this: age = (receive time − sender time) −
+  // the smallest such difference seen (the clock offset plus the base delay), that minimum
+  // allowed to rise by 100 µs per s to follow clock drift.
+  double max_age_ms = 20;
+  DeviceLimits limits{};
+};
+
+class UdpBridgeDevice final : public Device {
+ public:
+  // Opens and binds the socket and resolves the peer; throws InputError naming what failed.
+  explicit UdpBridgeDevice(UdpBridgeConfig config);
+  ~UdpBridgeDevice() override;
+
+  std::string_view name() const override;
+  DeviceLimits limits() const override;
+  uint16_t local_port() const;  // the bound port (useful with local_port = 0)
+
+  void start(int64_t now_ns) override;  // starts the I/O thread
+  void stop() override;                 // joins it (within ~1 ms)
+
+  bool read(int64_t now_ns, DeviceSample& out) override;
+  void write_force(const Vec3& force_mn, int64_t now_ns) override;
+  DeviceHealth health(int64_t now_ns) const override;
+  DeviceCounters counters() const override;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// The other end, for tests, tools and the perf harness: sends pose packets (or raw bytes) to a
+// device, receives its force packets. Blocking calls; not for a real-time thread.
+class UdpBridgePeer {
+ public:
+  // Binds bind_host:local_port (0 = ephemeral). Throws InputError.
+  explicit UdpBridgePeer(uint16_t local_port = 0, const std::string& bind_host = "127.0.0.1");
+  ~UdpBridgePeer();
+  UdpBridgePeer(const UdpBridgePeer&) = delete;
+  UdpBridgePeer& operator=(const UdpBridgePeer&) = delete;
+
+  uint16_t local_port() const { return local_port_; }
+  void set_device(const std::string& host, uint16_t port);  // where packets go; throws InputError
+  void send(const udp_protocol::PoseMessage& m);
+  void send_raw(std::span<const uint8_t> bytes);
+  // The next force packet that decodes, waiting at most timeout_ms; nullopt on timeout.
+  // Packets that do not decode are skipped.
+  std::optional<udp_protocol::ForceMessage> receive_force(double timeout_ms);
+
+ private:
+  int fd_ = -1;
+  uint16_t local_port_ = 0;
+  std::array<uint8_t, 16> device_addr_{};  // a sockaddr_in, kept opaque here
+  bool has_device_ = false;
+};
+
+// Microseconds on the steady clock, the sender timestamp UdpBridgePeer users normally send.
+uint64_t steady_time_us();
+
+}  // namespace phaco

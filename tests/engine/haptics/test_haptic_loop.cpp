@@ -1,0 +1,171 @@
+// HapticLoop: absolute deadlines, increasing indices, statistics consistent with the ticks seen,
+// stop/restart, and an honest real-time status. No timing thresholds: the machine may be loaded
+// (or sanitized); overruns are allowed and must then be accounted for exactly.
+#include <gtest/gtest.h>
+#include <sched.h>
+
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "engine/haptics/haptic_loop.hpp"
+
+namespace phaco {
+namespace {
+
+struct Recorder {
+  std::vector<TickInfo> ticks = std::vector<TickInfo>(4000);  // sized before start: no growth
+  std::atomic<int> count{0};
+  std::atomic<int> policy{-1};  // sched_getscheduler(0) as seen from the loop thread
+
+  static void tick(void* self, const TickInfo& info) {
+    auto* r = static_cast<Recorder*>(self);
+    // Relaxed: the loop thread is the only writer; the test reads after stop() joined it.
+    const int n = r->count.load(std::memory_order_relaxed);
+    if (n == 0) r->policy.store(sched_getscheduler(0), std::memory_order_relaxed);
+    if (n < static_cast<int>(r->ticks.size())) r->ticks[n] = info;
+    r->count.store(n + 1, std::memory_order_relaxed);
+  }
+};
+
+LoopSettings quiet_settings() {
+  LoopSettings s;
+  s.realtime = false;
+  s.lock_memory = false;  // MCL_FUTURE would stay on for the rest of the test binary
+  s.warmup_ticks = 5;
+  return s;
+}
+
+void run_until(const Recorder& r, int ticks) {
+  // Relaxed: a progress poll; correctness is checked after the join.
+  while (r.count.load(std::memory_order_relaxed) < ticks)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+}
+
+TEST(HapticLoop, AbsoluteDeadlinesIncreasingIndicesAndExactAccounting) {
+  Recorder r;
+  HapticLoop loop;
+  const LoopSettings settings = quiet_settings();
+  loop.start(&Recorder::tick, &r, settings);
+  EXPECT_TRUE(loop.running());
+  run_until(r, 60);
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+
+  const int n = r.count.load();
+  ASSERT_GE(n, 60);
+  ASSERT_LE(n, static_cast<int>(r.ticks.size()));
+  const int64_t period = settings.period_ns;
+  int64_t overruns = 0, missed_total = 0;
+  for (int i = 0; i < n; ++i) {
+    const TickInfo& t = r.ticks[i];
+    EXPECT_EQ(t.deadline_ns, loop.start_ns() + t.index * period) << i;  // exact, no drift
+    EXPECT_GE(t.wake_ns, t.deadline_ns) << i;
+    const int64_t missed = (t.wake_ns - t.deadline_ns) / period;
+    if (i > 0) {
+      EXPECT_GT(t.index, r.ticks[i - 1].index) << i;
+    }
+    if (i + 1 < n) {
+      EXPECT_EQ(r.ticks[i + 1].index, t.index + 1 + missed) << i;  // skip, no burst
+    }
+    if (i >= settings.warmup_ticks && missed > 0) {
+      ++overruns;
+      missed_total += missed;
+    }
+  }
+  EXPECT_EQ(r.ticks[0].index, 0);
+
+  const LoopStatsSnapshot s = loop.stats();
+  EXPECT_EQ(s.ticks, n - settings.warmup_ticks);  // warm-up not counted
+  EXPECT_EQ(s.lateness.count, s.ticks);
+  EXPECT_EQ(s.compute.count, s.ticks);
+  EXPECT_EQ(s.period.count, s.ticks);  // the first counted tick measures from the last warm-up one
+  EXPECT_EQ(s.overruns, overruns);
+  EXPECT_EQ(s.missed_deadlines, missed_total);
+  EXPECT_GE(s.lateness.min_us, 0.0);
+  EXPECT_LE(s.period.min_us, s.period.p50_us);
+  EXPECT_LE(s.period.p50_us, s.period.p99_us);
+  EXPECT_LE(s.period.p99_us, s.period.p999_us);
+  EXPECT_LE(s.period.p999_us, s.period.max_us);
+}
+
+TEST(HapticLoop, StopIsIdempotentAndTheLoopRestarts) {
+  Recorder r;
+  HapticLoop loop;
+  loop.stop();  // never started: nothing to do
+  loop.start(&Recorder::tick, &r, quiet_settings());
+  EXPECT_THROW(loop.start(&Recorder::tick, &r, quiet_settings()), std::logic_error);
+  run_until(r, 10);
+  loop.stop();
+  const int after_stop = r.count.load();
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(r.count.load(), after_stop);  // no tick after stop() returned
+
+  Recorder again;
+  loop.start(&Recorder::tick, &again, quiet_settings());
+  run_until(again, 10);
+  loop.stop();
+  EXPECT_EQ(again.ticks[0].index, 0);  // a fresh timeline
+  EXPECT_EQ(loop.stats().ticks, again.count.load() - quiet_settings().warmup_ticks);
+}
+
+TEST(HapticLoop, RejectsBadSettings) {
+  HapticLoop loop;
+  Recorder r;
+  LoopSettings s = quiet_settings();
+  s.period_ns = 0;
+  EXPECT_THROW(loop.start(&Recorder::tick, &r, s), std::invalid_argument);
+  s = quiet_settings();
+  s.spin_ns = -1;
+  EXPECT_THROW(loop.start(&Recorder::tick, &r, s), std::invalid_argument);
+  s = quiet_settings();
+  s.realtime = true;
+  s.priority = 0;
+  EXPECT_THROW(loop.start(&Recorder::tick, &r, s), std::invalid_argument);
+  EXPECT_THROW(loop.start(nullptr, &r, quiet_settings()), std::invalid_argument);
+  EXPECT_FALSE(loop.running());
+}
+
+TEST(HapticLoop, WithoutRealtimeReportsNotRequested) {
+  Recorder r;
+  HapticLoop loop;
+  loop.start(&Recorder::tick, &r, quiet_settings());
+  run_until(r, 3);
+  loop.stop();
+  const RealtimeStatus status = loop.realtime_status();
+  EXPECT_FALSE(status.requested);
+  EXPECT_FALSE(status.memory_locked);
+  EXPECT_EQ(status.fifo, r.policy.load() == SCHED_FIFO);  // read back, whatever it inherited
+}
+
+TEST(HapticLoop, RealtimeStatusMatchesWhatTheThreadRunsUnder) {
+  Recorder r;
+  HapticLoop loop;
+  LoopSettings s = quiet_settings();
+  s.realtime = true;
+  s.priority = 10;
+  loop.start(&Recorder::tick, &r, s);
+  run_until(r, 3);
+  loop.stop();
+  const RealtimeStatus status = loop.realtime_status();
+  EXPECT_TRUE(status.requested);
+  const int policy = r.policy.load();
+  ASSERT_NE(policy, -1);
+  EXPECT_EQ(status.fifo, policy == SCHED_FIFO);
+  if (status.fifo) {
+    EXPECT_EQ(status.priority, s.priority);
+    EXPECT_EQ(status.detail.find("refused"), std::string::npos) << status.detail;
+  } else {
+    EXPECT_NE(status.detail.find("SCHED_FIFO refused"), std::string::npos) << status.detail;
+  }
+  std::printf("real-time status: fifo=%d priority=%d detail='%s'\n", status.fifo, status.priority,
+              status.detail.c_str());
+}
+
+}  // namespace
+}  // namespace phaco

@@ -1,0 +1,70 @@
+// A scene stepped in real time beside the haptic session (procedures/haptics/realtime_run): a
+// scripted device drives the forceps, every frame publishes a model, the thread adopts them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "engine/haptics/scripted_device.hpp"
+#include "procedures/haptics/realtime_run.hpp"
+#include "tests/support/scene_run.hpp"
+
+namespace phaco {
+namespace {
+
+HapticSessionConfig quiet_config() {
+  HapticSessionConfig c;
+  c.loop.realtime = false;  // CI machines may refuse SCHED_FIFO; the logic is the same
+  c.loop.lock_memory = false;
+  c.loop.warmup_ticks = 0;
+  return c;
+}
+
+TEST(RealtimeRun, AScriptedDeviceDrivesTheSceneInRealTime) {
+  // The demo's forceps (left) from a scripted device, the first 1.5 s, in real time.
+  const Scenario s = test::repo_scenario("capsulorhexis_demo.json");
+  const HandTrack* left = s.find_hand(Hand::Left);
+  ASSERT_NE(left, nullptr);
+  HapticSession session(quiet_config());
+  session.attach(Hand::Left, std::make_unique<ScriptedDevice>(*left));
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  RealtimeRunOptions run;
+  run.duration_s = 1.5;
+  const RealtimeRunReport r = run_realtime(s, o, session, run);
+  EXPECT_EQ(r.frames, static_cast<uint64_t>(std::ceil(1.5 / s.dt_s - 1e-9)));
+  EXPECT_GE(r.haptics.models_published, r.frames)
+      << "one model per frame (and one before the start)";
+  const HapticHandStats& h = r.haptics.hands[static_cast<size_t>(Hand::Left)];
+  EXPECT_TRUE(h.attached);
+  EXPECT_GT(h.ticks, 100u);
+  EXPECT_GT(h.samples, 100u);
+  EXPECT_GT(h.models_adopted, 10u);
+  EXPECT_FALSE(r.haptics.hands[static_cast<size_t>(Hand::Right)].attached);
+  const nlohmann::json j = to_json(r);
+  EXPECT_TRUE(j["haptics"]["hands"].contains("left"));
+  EXPECT_NE(summary_text(r).find("haptic thread"), std::string::npos);
+}
+
+TEST(RealtimeRun, AStalledSimulationLeavesTheHapticThreadRunning) {
+  const Scenario s = test::repo_scenario("capsulorhexis_demo.json");
+  HapticSession session(quiet_config());
+  session.attach(Hand::Left, std::make_unique<ScriptedDevice>(*s.find_hand(Hand::Left)));
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  RealtimeRunOptions run;
+  run.duration_s = 0.6;
+  run.stall_at_s = 0.2;
+  run.stall_ms = 200;
+  const RealtimeRunReport r = run_realtime(s, o, session, run);
+  const auto planned = static_cast<uint64_t>(std::ceil(0.6 / s.dt_s - 1e-9));
+  EXPECT_EQ(r.frames, planned - 1) << "one frame slot spent stalled";
+  EXPECT_GE(r.late_frames, 1u) << "the frames after the stall start late";
+  const HapticHandStats& h = r.haptics.hands[static_cast<size_t>(Hand::Left)];
+  // 200 ms without a model: the haptic thread went on ticking and reading the device.
+  EXPECT_GT(h.ticks, 300u);
+  EXPECT_GT(h.samples, 300u);
+  EXPECT_EQ(h.zero_force_ticks, 0u);
+}
+
+}  // namespace
+}  // namespace phaco
