@@ -34,7 +34,8 @@ std::string scene_section(const std::vector<SceneHapticsRow>& rows,
       "period_p99_us",  "period_p999_us", "period_max_us",  "late_p50_us",    "late_p99_us",
       "late_max_us",    "compute_p50_us", "compute_p99_us", "compute_max_us", "latency_p50_us",
       "latency_p99_us", "latency_max_us", "allocations",    "max_force_mn",   "max_force_step_mn",
-      "models",         "frames",         "frame_p50_ms",   "frame_p99_ms",   "late_frames"};
+      "models",         "frames",         "frame_p50_ms",   "frame_p99_ms",   "late_frames",
+      "steal_ms"};
   for (const auto& r : rows)
     t.add({r.c.label,
            r.c.seconds,
@@ -65,7 +66,8 @@ std::string scene_section(const std::vector<SceneHapticsRow>& rows,
            r.frames,
            r.frame_p50_ms,
            r.frame_p99_ms,
-           r.late_frames});
+           r.late_frames,
+           r.steal_ms});
   write_csv(t, dir / "haptics_scene.csv");
   write_json(t, dir / "haptics_scene.json");
 
@@ -87,7 +89,8 @@ std::string scene_section(const std::vector<SceneHapticsRow>& rows,
       "| compute p50 / "
       "p99 / max (us) | latency p50 / p99 / max (us) | overruns | allocations | max force (mN) | "
       "max step (mN) | "
-      "models | late frames |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "models | late frames | stolen (ms) "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     md += "| " + r.c.label + " | " + (r.fifo ? "SCHED_FIFO" : "normal") + " | " +
           fmt("%.0f", r.c.seconds) + " | " + fmt("%.1f", r.period_p50_us) + " / " +
@@ -100,7 +103,8 @@ std::string scene_section(const std::vector<SceneHapticsRow>& rows,
           fmt("%.0f", r.overruns) + " | " +
           (r.allocations < 0 ? std::string("n/a") : fmt("%.0f", r.allocations)) + " | " +
           fmt("%.1f", r.max_force_mn) + " | " + fmt("%.2f", r.max_force_step_mn) + " | " +
-          fmt("%.0f", r.models) + " | " + fmt("%.0f", r.late_frames) + " |\n";
+          fmt("%.0f", r.models) + " | " + fmt("%.0f", r.late_frames) + " | " +
+          fmt("%.0f", r.steal_ms) + " |\n";
   }
   md += "\n";
   for (const auto& r : rows) {
@@ -184,22 +188,20 @@ std::string stability_section(const std::vector<StiffnessLimitRow>& limits,
   Chart c{.title = "Largest passive stiffness against the haptic rate",
           .x = {"haptic rate (Hz)", Scale::Log10},
           .y = {"stiffness (mN/mm)", Scale::Log10}};
-  Series bound{.name = "Colgate bound 2b/T", .dashed = true};
-  std::vector<Series> measured;
+  // Per scene: the measured limit and its own bound (each scene's device damping b differs).
+  std::vector<Series> measured, bounds;
   for (const auto& r : limits) {
-    Series* s = nullptr;
-    for (auto& m : measured)
-      if (m.name == r.scene) s = &m;
-    if (!s) {
+    size_t k = 0;
+    while (k < measured.size() && measured[k].name != r.scene) ++k;
+    if (k == measured.size()) {
       measured.push_back(Series{.name = r.scene});
-      s = &measured.back();
+      bounds.push_back(Series{.name = "2b/T, " + r.scene, .dashed = true});
     }
-    s->x.push_back(r.rate_hz), s->y.push_back(r.passive_limit_mn_per_mm);
-    if (r.scene == limits.front().scene)
-      bound.x.push_back(r.rate_hz), bound.y.push_back(r.colgate_bound_mn_per_mm);
+    measured[k].x.push_back(r.rate_hz), measured[k].y.push_back(r.passive_limit_mn_per_mm);
+    bounds[k].x.push_back(r.rate_hz), bounds[k].y.push_back(r.colgate_bound_mn_per_mm);
   }
-  for (auto& m : measured) c.series.push_back(m);
-  c.series.push_back(bound);
+  for (size_t k = 0; k < measured.size(); ++k)
+    c.series.push_back(measured[k]), c.series.push_back(bounds[k]);
   save_chart(c, dir / "haptics_stiffness.png");
 
   std::string md = "### Stability of the local model: passive stiffness against rate\n\n";
@@ -320,7 +322,8 @@ void run_haptics(const StudyOptions& options) {
   const std::string load = load_note();
   const auto dir = options.out_dir / "results";
   Progress progress(5);
-  const double long_s = options.quick ? 5 : 60, short_s = options.quick ? 3 : 15;
+  const double long_s = options.quick ? 5 : 60,
+               short_s = options.quick ? 6 : 15;  // the forceps grasp at 3.5 s
 
   progress.step("haptics: beside the scene");
   std::vector<SceneHapticsCase> cases = {

@@ -183,6 +183,10 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
   HapticSessionConfig config;
   config.loop.realtime = !a.flag("--no-rt");
   config.loop.lock_memory = config.loop.realtime;
+  if (auto spin = a.option("--spin-us")) {
+    config.loop.spin_ns =
+        static_cast<int64_t>(parse_seconds("run", "--spin-us", *spin, 0, 1000) * 1e3);
+  }
   HapticSession session(config);
   session.attach(hand, make_device(spec, context));
   RealtimeRunOptions run;
@@ -212,12 +216,12 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
 int run(const std::vector<std::string>& raw) {
   const Args a = parse("run", raw,
                        {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration",
-                        "--stall-at", "--stall-ms"},
+                        "--stall-at", "--stall-ms", "--spin-us"},
                        {"--json", "--no-rt"});
   if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
   const Scenario scenario = load_scenario(a.positional[0]);
   if (auto spec = a.option("--haptics")) return run_with_haptics(a, scenario, *spec);
-  for (const char* o : {"--hand", "--duration", "--stall-at", "--stall-ms"}) {
+  for (const char* o : {"--hand", "--duration", "--stall-at", "--stall-ms", "--spin-us"}) {
     if (a.option(o)) throw InputError(std::string("run: ") + o + " needs --haptics");
   }
   if (a.flag("--no-rt")) throw InputError("run: --no-rt needs --haptics");

@@ -15,7 +15,7 @@ usage:
   phaco run FILE [--threads N] [--report OUT.json] [--json] [--cache-dir DIR]
       Run a scenario headless for its duration at its fixed step; print a summary
       (or, with --json, the JSON report) and write the JSON report to OUT.json.
-  phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--duration S]
+  phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
       Run the scenario in real time with the 1 kHz haptic thread; DEVICE drives one hand's tool
       and feels the force of the local haptic model (docs/haptics.md):
@@ -24,7 +24,8 @@ usage:
         udp:LOCALPORT@PEERHOST:PEERPORT  a device driven by another process (docs/udp_bridge_protocol.md)
         openhaptics[:NAME]               a Phantom-class device (only when built with the SDK)
       The haptic thread asks for SCHED_FIFO (--no-rt: it does not) and the summary says whether
-      it got it. --duration runs longer or shorter than the scenario (it restarts when it ends);
+      it got it. --spin-us: the loop sleeps to the deadline minus this, then spins (default 60).
+      --duration runs longer or shorter than the scenario (it restarts when it ends);
       --stall-at/--stall-ms make the simulation hang once, to show the force stays continuous.
   phaco validate FILE...
       Check scenario files; every problem is named by file, JSON path and what was expected.

@@ -1,10 +1,16 @@
 #include "perf/haptics/scene_haptics_measure.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "engine/core/clock.hpp"
@@ -52,6 +58,40 @@ class CountingDevice final : public Device {
   std::atomic<bool> armed_{false}, marked_{false};
 };
 
+// Sum of the "steal" column over all cores (/proc/stat first line), in ms; −1 where unreadable.
+double steal_ms() {
+  std::ifstream in("/proc/stat");
+  std::string line;
+  if (!std::getline(in, line)) return -1;
+  std::istringstream words(line);
+  std::string cpu;
+  double v[8] = {};
+  words >> cpu;
+  for (double& x : v) words >> x;
+  if (!words) return -1;
+  return v[7] * 1000.0 / double(sysconf(_SC_CLK_TCK));
+}
+
+// Pins the calling thread to one CPU for the scope; restores its previous set after.
+class PinnedScope {
+ public:
+  explicit PinnedScope(int cpu) {
+    if (cpu < 0) return;
+    ok_ = pthread_getaffinity_np(pthread_self(), sizeof old_, &old_) == 0;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    ok_ = ok_ && pthread_setaffinity_np(pthread_self(), sizeof set, &set) == 0;
+  }
+  ~PinnedScope() {
+    if (ok_) pthread_setaffinity_np(pthread_self(), sizeof old_, &old_);
+  }
+
+ private:
+  cpu_set_t old_{};
+  bool ok_ = false;
+};
+
 }  // namespace
 
 std::vector<SceneHapticsRow> measure_scene_haptics(const std::vector<SceneHapticsCase>& cases) {
@@ -62,6 +102,8 @@ std::vector<SceneHapticsRow> measure_scene_haptics(const std::vector<SceneHaptic
     config.loop.realtime = c.realtime;
     config.loop.lock_memory = c.realtime;
     config.min_model_interval_ms = c.model_interval_ms;
+    const bool two_cores = std::thread::hardware_concurrency() >= 2;
+    if (two_cores) config.loop.cpu = 1;
     HapticSession session(config);
     auto counting = std::make_unique<CountingDevice>(
         std::make_unique<ScriptedDevice>(*s.find_hand(Hand::Left)));
@@ -79,7 +121,13 @@ std::vector<SceneHapticsRow> measure_scene_haptics(const std::vector<SceneHaptic
     run.duration_s = c.seconds;
     run.stall_at_s = c.stall_at_s;
     run.stall_ms = c.stall_ms;
-    const RealtimeRunReport r = run_realtime(s, SceneOptions{}, session, run);
+    const double steal_before = steal_ms();
+    RealtimeRunReport r;
+    {
+      PinnedScope pin(two_cores ? 0 : -1);
+      r = run_realtime(s, SceneOptions{}, session, run);
+    }
+    const double steal_after = steal_ms();
     if (countable) test::close_allocation_window();
 
     SceneHapticsRow row;
@@ -104,6 +152,7 @@ std::vector<SceneHapticsRow> measure_scene_haptics(const std::vector<SceneHaptic
     row.models = double(hand.models_adopted), row.frames = double(r.frames);
     row.frame_p50_ms = r.frame_p50_ms, row.frame_p99_ms = r.frame_p99_ms;
     row.late_frames = double(r.late_frames);
+    row.steal_ms = steal_before >= 0 && steal_after >= 0 ? steal_after - steal_before : -1;
     rows.push_back(row);
   }
   return rows;
