@@ -16,6 +16,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev       # Google Benchmark
   libglfw3-dev libepoxy-dev libimgui-dev   # trainer (later issues)
+  chromium               # headless check of the HTML report
 )
 
 missing=()

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <optional>
 
+#include "apps/phaco/args.hpp"
+#include "apps/phaco/records_commands.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
 #include "engine/haptics/device_factory.hpp"
@@ -18,42 +21,6 @@
 namespace phaco::cli {
 
 namespace {
-
-// Options of the form --name VALUE, plus flags; everything else is positional.
-struct Args {
-  std::vector<std::string> positional;
-  std::vector<std::pair<std::string, std::string>> options;
-  std::vector<std::string> flags;
-
-  std::optional<std::string> option(const std::string& name) const {
-    for (const auto& [k, v] : options) {
-      if (k == name) return v;
-    }
-    return std::nullopt;
-  }
-  bool flag(const std::string& name) const {
-    return std::find(flags.begin(), flags.end(), name) != flags.end();
-  }
-};
-
-Args parse(const std::string& command, const std::vector<std::string>& raw,
-           const std::vector<std::string>& valued, const std::vector<std::string>& flags) {
-  Args a;
-  for (size_t i = 0; i < raw.size(); ++i) {
-    const std::string& s = raw[i];
-    if (s.rfind("--", 0) != 0) {
-      a.positional.push_back(s);
-    } else if (std::find(valued.begin(), valued.end(), s) != valued.end()) {
-      if (i + 1 >= raw.size()) throw InputError(command + ": option " + s + " needs a value");
-      a.options.push_back({s, raw[++i]});
-    } else if (std::find(flags.begin(), flags.end(), s) != flags.end()) {
-      a.flags.push_back(s);
-    } else {
-      throw InputError(command + ": unknown option '" + s + "' (try 'phaco --help')");
-    }
-  }
-  return a;
-}
 
 int parse_int(const std::string& command, const std::string& option, const std::string& text,
               int lo, int hi) {
@@ -77,6 +44,16 @@ double parse_seconds(const std::string& command, const std::string& option, cons
   return value;
 }
 
+// "2026-11-21T19:30:00Z".
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
 void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path);
   if (!out) throw InputError("cannot write '" + path.string() + "'");
@@ -94,7 +71,7 @@ SceneOptions scene_options(const Args& a, const std::string& command) {
 }  // namespace
 
 int validate(const std::vector<std::string>& raw) {
-  const Args a = parse("validate", raw, {}, {});
+  const Args a = parse_args("validate", raw, {}, {});
   if (a.positional.empty()) throw InputError("validate: give one or more scenario files");
   int status = kOk;
   for (const auto& file : a.positional) {
@@ -112,7 +89,8 @@ int validate(const std::vector<std::string>& raw) {
 }
 
 int mesh(const std::vector<std::string>& raw) {
-  const Args a = parse("mesh", raw, {"--level", "--out", "--layout", "--params"}, {"--no-tets"});
+  const Args a =
+      parse_args("mesh", raw, {"--level", "--out", "--layout", "--params"}, {"--no-tets"});
   if (!a.positional.empty())
     throw InputError("mesh: unexpected argument '" + a.positional[0] + "'");
   const auto out = a.option("--out");
@@ -214,10 +192,11 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
 }
 
 int run(const std::vector<std::string>& raw) {
-  const Args a = parse("run", raw,
-                       {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration",
-                        "--stall-at", "--stall-ms", "--spin-us"},
-                       {"--json", "--no-rt"});
+  const Args a =
+      parse_args("run", raw,
+                 {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration",
+                  "--stall-at", "--stall-ms", "--spin-us", "--record", "--trainee"},
+                 {"--json", "--no-rt"});
   if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
   const Scenario scenario = load_scenario(a.positional[0]);
   if (auto spec = a.option("--haptics")) return run_with_haptics(a, scenario, *spec);
@@ -225,9 +204,23 @@ int run(const std::vector<std::string>& raw) {
     if (a.option(o)) throw InputError(std::string("run: ") + o + " needs --haptics");
   }
   if (a.flag("--no-rt")) throw InputError("run: --no-rt needs --haptics");
+  // Records (issue 7, docs/records.md): checked before the drill, stored after it.
+  std::optional<std::filesystem::path> db;
+  const auto trainee = a.option("--trainee");
+  if (a.option("--record") || trainee) {
+    if (!trainee) throw InputError("run: --record needs --trainee NAME");
+    db = a.option("--record") ? std::filesystem::path(*a.option("--record")) : default_records_db();
+    check_record_target(*db, *trainee);
+  }
   const RunReport report = run_scenario(scenario, scene_options(a, "run"));
-  const nlohmann::json j = to_json(report);
+  nlohmann::json j = to_json(report);
+  j["date"] = utc_now();  // when the run finished, for the HTML report and the records
   if (auto path = a.option("--report")) write_text(*path, j.dump(2) + "\n");
+  if (db) {
+    const int64_t id = record_run(*db, *trainee, scenario, j);
+    std::fprintf(stderr, "recorded as record %lld in %s\n", static_cast<long long>(id),
+                 db->c_str());
+  }
   if (a.flag("--json")) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -238,7 +231,7 @@ int run(const std::vector<std::string>& raw) {
 }
 
 int graph(const std::vector<std::string>& raw) {
-  const Args a = parse("graph", raw, {"--out", "--threads", "--cache-dir"}, {});
+  const Args a = parse_args("graph", raw, {"--out", "--threads", "--cache-dir"}, {});
   if (a.positional.size() != 1) throw InputError("graph: give exactly one scenario file");
   const Scenario scenario = load_scenario(a.positional[0]);
   const auto scene = build_scene(scenario, scene_options(a, "graph"));

@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "apps/phaco/commands.hpp"
+#include "apps/phaco/records_commands.hpp"
+#include "apps/phaco/report_command.hpp"
 #include "engine/core/error.hpp"
 
 namespace {
@@ -13,8 +15,11 @@ constexpr const char* kUsage = R"(phaco — OpenPhaco headless simulator
 
 usage:
   phaco run FILE [--threads N] [--report OUT.json] [--json] [--cache-dir DIR]
-      Run a scenario headless for its duration at its fixed step; print a summary
-      (or, with --json, the JSON report) and write the JSON report to OUT.json.
+                 [--record DB --trainee NAME]
+      Run a scenario headless for its duration at its fixed step; print a summary with the
+      drill's metrics and 0-100 score (docs/scoring.md), or, with --json, the JSON report; write
+      the JSON report to OUT.json; with --trainee, store the run in the records database
+      (DB, default $PHACO_RECORDS_DB or ~/.local/share/openphaco/records.sqlite; docs/records.md).
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
       Run the scenario in real time with the 1 kHz haptic thread; DEVICE drives one hand's tool
@@ -32,6 +37,14 @@ usage:
   phaco mesh --level L --out DIR [--layout curvilinear|isotropic] [--no-tets] [--params FILE]
       Generate the standard eye's meshes at resolution level L (0..7, default eye level 3:
       about 8k capsule vertices, 50k lens tets) as OBJ and TetGen .node/.ele files.
+  phaco report RUN.json --html OUT.html
+      Write a run report (phaco run --report) as one self-contained HTML page: the score and its
+      terms, every metric against its target, the events, and plots (force, speed, paths, the
+      rhexis against its target circle, the trench from above) (docs/report.md).
+  phaco history TRAINEE [--db DB] [--json]
+      The trainee's recorded sessions in date order (drill, score, key metrics) and the trend.
+  phaco export ID [--db DB] [--xml OUT] [--json OUT] [--scenario OUT]
+      One record as XML (seed 000 §6.4), JSON, or the scenario that replays it with phaco run.
   phaco graph FILE [--out OUT.dot]
       Print the scenario's per-frame task graph as GraphViz DOT.
   phaco --help | --version
@@ -70,6 +83,9 @@ int main(int argc, char** argv) {
     if (command == "validate") return phaco::cli::validate(args);
     if (command == "mesh") return phaco::cli::mesh(args);
     if (command == "graph") return phaco::cli::graph(args);
+    if (command == "report") return phaco::cli::report(args);
+    if (command == "history") return phaco::cli::history(args);
+    if (command == "export") return phaco::cli::export_record(args);
     std::fprintf(stderr, "phaco: unknown command '%s' (try 'phaco --help')\n", command.c_str());
     return phaco::cli::kBadInput;
   } catch (const phaco::InputError& e) {

@@ -81,6 +81,9 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
   std::vector<cv::Point> simplified;
   cv::approxPolyDP(c, simplified, 1.0, true);
   out.perimeter_mm = std::max(out.perimeter_mm, cv::arcLength(simplified, true) * pixel_mm);
+  out.outline_mm.reserve(simplified.size());
+  for (const cv::Point& q : simplified)
+    out.outline_mm.push_back({q.x * pixel_mm - field_mm, q.y * pixel_mm - field_mm});
   out.circularity = out.perimeter_mm > 0 ? 4.0 * 3.14159265358979323846 * out.area_mm2 /
                                                (out.perimeter_mm * out.perimeter_mm)
                                          : 0.0;

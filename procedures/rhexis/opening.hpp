@@ -12,7 +12,9 @@
 // no uncovered region: complete = false.
 //
 // Reads: particles (x, y), triangles, adjacency (through the cut mesh). Writes nothing.
+#include <array>
 #include <cstdint>
+#include <vector>
 
 #include "systems/cut/membrane_edit.hpp"
 
@@ -27,6 +29,9 @@ struct Opening {
   double perimeter_mm = 0.0;
   double circularity = 0.0;          // 4πA/P²
   double centering_mm = 0.0;         // centroid distance from the optical axis
+  // The opening's contour seen down the axis, simplified to within a pixel, closed implicitly
+  // (x, y in mm, scene frame): what a report draws against the target circle.
+  std::vector<std::array<double, 2>> outline_mm;
 };
 
 // pixel_mm: raster resolution; field_mm: half-width of the square field around the axis.

@@ -8,6 +8,7 @@
 #include "engine/core/clock.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
 
@@ -58,6 +59,12 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
     r.physics["lens_sculpting"] = lens;
   if (auto lens = lens_fragments_summary(*scene); !lens.is_null())
     r.physics["lens_fragments"] = lens;
+  DrillReport drill = drill_report(*scene);
+  r.metrics = std::move(drill.metrics);
+  r.targets = std::move(drill.targets);
+  r.events = std::move(drill.events);
+  r.series = std::move(drill.series);
+  r.score_terms = std::move(drill.score_terms);
   r.peak_memory_mb = peak_memory_mb();
   return r;
 }
@@ -84,7 +91,10 @@ nlohmann::json to_json(const RunReport& r) {
   for (const auto& [k, v] : r.elements) elements[k] = v;
   j["elements"] = elements;
   j["metrics"] = r.metrics;
+  j["targets"] = r.targets;
   j["events"] = r.events;
+  j["series"] = r.series;
+  j["score_terms"] = r.score_terms;
   j["physics"] = r.physics;
   j["state_hash"] = r.state_hash;
   return j;
@@ -171,6 +181,29 @@ std::string summary_text(const RunReport& r) {
            std::to_string(ph.value("frames_stepped", 0ull)) + " frames stepped, " +
            std::to_string(ph.value("divergences", 0ull)) + " divergences, " +
            std::to_string(ph.value("grasps", 0ull)) + " grasps";
+  }
+  if (r.metrics.contains("score")) {
+    std::snprintf(line, sizeof line, "\nscore %.1f / 100", r.metrics["score"].get<double>());
+    out += line;
+    for (const auto& t : r.score_terms) {
+      const std::string value = t["value"].is_number() ? t["value"].dump() : std::string("-");
+      std::snprintf(line, sizeof line, "\n  %-28s %-12s %5.1f / %4.1f",
+                    t.value("metric", std::string()).c_str(), value.c_str(), t.value("points", 0.0),
+                    t.value("weight", 0.0));
+      out += line;
+    }
+  }
+  if (!r.metrics.empty()) out += "\nmetrics:";
+  for (const auto& [name, value] : r.metrics.items()) {
+    std::string target;
+    if (r.targets.contains(name)) {
+      const auto& b = r.targets[name];
+      target = "  target " + (b.contains("min") ? b["min"].dump() : std::string()) + ".." +
+               (b.contains("max") ? b["max"].dump() : std::string());
+    }
+    std::snprintf(line, sizeof line, "\n  %-32s %.4g%s", name.c_str(),
+                  value.is_number() ? value.get<double>() : 0.0, target.c_str());
+    out += line;
   }
   std::snprintf(line, sizeof line,
                 "\npeak memory %.1f MiB   metrics %zu   events %zu   state hash %s\n",

@@ -23,14 +23,20 @@ struct RunReport {
   int threads = 1;
   double dt_s = 0;
   std::vector<SystemCost> systems;
-  SystemCost frame;          // the whole frame
-  double wall_time_s = 0;    // stepping only
-  double mesh_load_s = 0;    // meshes loaded from the cache or generated
+  SystemCost frame;        // the whole frame
+  double wall_time_s = 0;  // stepping only
+  double mesh_load_s = 0;  // meshes loaded from the cache or generated
   double peak_memory_mb = 0;
   std::vector<std::pair<std::string, uint64_t>> elements;
-  nlohmann::json metrics = nlohmann::json::object();  // filled by the drills (issue 7)
-  nlohmann::json events = nlohmann::json::array();
-  nlohmann::json physics = nlohmann::json::object();  // per deformable body: method, steps, divergences, active set
+  // Issue 7 item 3 (procedures/scene/drill_metrics.hpp, docs/metrics.md, docs/scoring.md).
+  nlohmann::json metrics = nlohmann::json::object();  // name (units in it) → number, with "score"
+  nlohmann::json targets = nlohmann::json::object();  // name → {"min": a, "max": b}
+  nlohmann::json events = nlohmann::json::array();    // {"t_s", "kind", "hand"?, ...} by time
+  nlohmann::json series = nlohmann::json::object();  // t_s, hands, rhexis, trench (≤ 2000 samples)
+  // The score's breakdown: {"metric", "value", "target", "weight", "points"} per term.
+  nlohmann::json score_terms = nlohmann::json::array();
+  // Per deformable body: method, steps, divergences, active set.
+  nlohmann::json physics = nlohmann::json::object();
   std::string state_hash;
 };
 

@@ -15,6 +15,7 @@
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
@@ -269,6 +270,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
     }
   }
   if (scene->haptics) systems.push_back(haptic_publish_system(*scene));
+  systems.push_back(drill_metrics_system(*scene));  // last: it only reads (issue 7 item 3)
   if (options.extra_systems) {
     for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));
   }

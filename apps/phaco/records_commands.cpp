@@ -1,0 +1,285 @@
+#include "apps/phaco/records_commands.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <map>
+
+#include "apps/phaco/args.hpp"
+#include "apps/phaco/commands.hpp"
+#include "engine/core/error.hpp"
+#include "engine/records/records.hpp"
+
+namespace phaco::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// The few metrics that say how a drill went at a glance; the rest are in the export.
+const std::vector<std::string>& key_metrics(const std::string& drill) {
+  static const std::map<std::string, std::vector<std::string>> kKeys = {
+      {"corneal_incision",
+       {"incision.width_mm", "incision.entry_angle_deg", "incision.tunnel_length_mm", "time_s"}},
+      {"capsulorhexis",
+       {"rhexis.diameter_mm", "rhexis.circularity", "rhexis.centering_mm", "rhexis.radial_tearouts",
+        "time_s"}},
+      {"phaco_sculpting", {"trench.depth_fraction", "trench.width_mm", "capsule_breach", "time_s"}},
+  };
+  static const std::vector<std::string> kDefault = {"time_s"};
+  const auto it = kKeys.find(drill);
+  return it == kKeys.end() ? kDefault : it->second;
+}
+
+std::string show(const json& v) {
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_number()) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v.get<double>());
+    return buf;
+  }
+  if (v.is_string()) return v.get<std::string>();
+  return v.dump();
+}
+
+std::string show_score(const std::optional<double>& s) {
+  if (!s) return "-";
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%.1f", *s);
+  return buf;
+}
+
+// "2026-11-21T19:18:01.123Z" -> "2026-11-21 19:18:01": what a person reads in a table.
+std::string show_date(const std::string& utc) {
+  std::string d = utc.substr(0, 19);
+  if (d.size() > 10 && d[10] == 'T') d[10] = ' ';
+  return d;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw InputError("cannot write '" + path.string() + "'");
+  out << text;
+  if (!out.flush()) throw InputError("cannot write '" + path.string() + "'");
+}
+
+fs::path db_path(const Args& a) {
+  if (auto db = a.option("--db")) return *db;
+  return default_records_db();
+}
+
+struct Trend {
+  int sessions = 0, scored = 0;
+  double first = 0, last = 0, best = 0;
+  int64_t best_id = 0;
+  std::string best_date;
+};
+
+std::map<std::string, Trend> trends(const std::vector<SessionRecord>& records) {
+  std::map<std::string, Trend> out;
+  for (const SessionRecord& r : records) {
+    Trend& t = out[r.drill];
+    ++t.sessions;
+    if (!r.score) continue;
+    if (t.scored == 0) t.first = *r.score;
+    t.last = *r.score;
+    if (t.scored == 0 || *r.score > t.best) {
+      t.best = *r.score;
+      t.best_id = r.id;
+      t.best_date = r.started_utc;
+    }
+    ++t.scored;
+  }
+  return out;
+}
+
+void check_trainee(const std::string& trainee) {
+  if (trainee.empty()) throw InputError("run: --trainee needs a name");
+  if (trainee.size() > 200) throw InputError("run: --trainee name is longer than 200 characters");
+  for (const char c : trainee) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      throw InputError("run: --trainee name contains a control character");
+    }
+  }
+}
+
+void make_parent_dir(const fs::path& db) {
+  if (!db.has_parent_path()) return;
+  std::error_code ec;
+  fs::create_directories(db.parent_path(), ec);
+  if (ec) throw InputError("cannot create '" + db.parent_path().string() + "': " + ec.message());
+}
+
+}  // namespace
+
+fs::path default_records_db() {
+  if (const char* env = std::getenv("PHACO_RECORDS_DB"); env && *env) return env;
+  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg) {
+    return fs::path(xdg) / "openphaco" / "records.sqlite";
+  }
+  if (const char* home = std::getenv("HOME"); home && *home) {
+    return fs::path(home) / ".local" / "share" / "openphaco" / "records.sqlite";
+  }
+  throw InputError("no records database: give --db FILE or set PHACO_RECORDS_DB");
+}
+
+int history(const std::vector<std::string>& raw) {
+  const Args a = parse_args("history", raw, {"--db"}, {"--json"});
+  if (a.positional.size() != 1) throw InputError("history: give exactly one trainee name");
+  const std::string& trainee = a.positional[0];
+  const fs::path db = db_path(a);
+  const RecordStore store(db, OpenMode::ExistingOnly);
+  const std::vector<SessionRecord> records = store.records_of(trainee);
+  if (records.empty()) {
+    std::string known;
+    for (const auto& name : store.trainees()) known += (known.empty() ? "" : ", ") + name;
+    throw InputError("history: no records for trainee '" + trainee + "' in " + db.string() +
+                     (known.empty() ? " (it holds no records)" : " (trainees: " + known + ")"));
+  }
+  const auto by_drill = trends(records);
+
+  if (a.flag("--json")) {
+    json out = {{"trainee", trainee}, {"db", db.string()}};
+    json rows = json::array();
+    for (const SessionRecord& r : records) {
+      json keys = json::object();
+      for (const auto& k : key_metrics(r.drill)) {
+        if (r.metrics.contains(k)) keys[k] = r.metrics[k];
+      }
+      rows.push_back({{"id", r.id},
+                      {"started_utc", r.started_utc},
+                      {"drill", r.drill},
+                      {"scenario", r.scenario_name},
+                      {"score", r.score ? json(*r.score) : json(nullptr)},
+                      {"metrics", keys}});
+    }
+    out["records"] = std::move(rows);
+    json trend = json::object();
+    for (const auto& [drill, t] : by_drill) {
+      json d = {{"sessions", t.sessions}, {"scored", t.scored}};
+      if (t.scored > 0) {
+        d["first_score"] = t.first;
+        d["last_score"] = t.last;
+        d["change"] = t.last - t.first;
+        d["best_score"] = t.best;
+        d["best_id"] = t.best_id;
+      }
+      trend[drill] = std::move(d);
+    }
+    out["trend"] = std::move(trend);
+    std::printf("%s\n", out.dump(2).c_str());
+    return kOk;
+  }
+
+  std::printf("trainee %s: %zu session(s) in %s\n", trainee.c_str(), records.size(),
+              db.string().c_str());
+  std::printf("  %5s  %-19s  %-16s  %5s  %s\n", "id", "date (UTC)", "drill", "score",
+              "key metrics");
+  for (const SessionRecord& r : records) {
+    std::string keys;
+    for (const auto& k : key_metrics(r.drill)) {
+      if (!r.metrics.contains(k)) continue;
+      keys += (keys.empty() ? "" : ", ") + k + " " + show(r.metrics[k]);
+    }
+    std::printf("  %5lld  %-19s  %-16s  %5s  %s\n", static_cast<long long>(r.id),
+                show_date(r.started_utc).c_str(), r.drill.c_str(), show_score(r.score).c_str(),
+                keys.empty() ? "-" : keys.c_str());
+  }
+  std::printf("trend:\n");
+  for (const auto& [drill, t] : by_drill) {
+    if (t.scored == 0) {
+      std::printf("  %-16s %d session(s), none scored\n", drill.c_str(), t.sessions);
+      continue;
+    }
+    std::printf("  %-16s %d session(s), score %.1f -> %.1f (%+.1f), best %.1f (#%lld, %s)\n",
+                drill.c_str(), t.sessions, t.first, t.last, t.last - t.first, t.best,
+                static_cast<long long>(t.best_id), show_date(t.best_date).substr(0, 10).c_str());
+  }
+  return kOk;
+}
+
+int export_record(const std::vector<std::string>& raw) {
+  const Args a = parse_args("export", raw, {"--db", "--xml", "--json", "--scenario"}, {});
+  if (a.positional.size() != 1) throw InputError("export: give exactly one record id");
+  const std::string& text = a.positional[0];
+  int64_t id = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
+  if (ec != std::errc{} || end != text.data() + text.size() || id < 1) {
+    throw InputError("export: a record id is a positive integer, got '" + text + "'");
+  }
+  const auto xml = a.option("--xml");
+  const auto js = a.option("--json");
+  const auto scen = a.option("--scenario");
+  if (!xml && !js && !scen)
+    throw InputError("export: give --xml OUT, --json OUT or --scenario OUT");
+  const fs::path db = db_path(a);
+  const RecordStore store(db, OpenMode::ExistingOnly);
+  const auto record = store.record(id);
+  if (!record) throw InputError("export: no record " + text + " in " + db.string());
+  if (xml) {
+    write_text(*xml, records_to_xml({*record}));
+    std::printf("record %lld written as XML to %s\n", static_cast<long long>(id), xml->c_str());
+  }
+  if (js) {
+    write_text(*js, record_to_json(*record).dump(2) + "\n");
+    std::printf("record %lld written as JSON to %s\n", static_cast<long long>(id), js->c_str());
+  }
+  if (scen) {
+    write_text(*scen, record->recording.dump(2) + "\n");
+    std::printf("record %lld written as a scenario to %s (replay: phaco run %s)\n",
+                static_cast<long long>(id), scen->c_str(), scen->c_str());
+  }
+  return kOk;
+}
+
+void check_record_target(const fs::path& db, const std::string& trainee) {
+  check_trainee(trainee);
+  make_parent_dir(db);
+  const RecordStore store(db, OpenMode::CreateIfMissing);
+}
+
+int64_t record_run(const fs::path& db, const std::string& trainee, const Scenario& scenario,
+                   const json& report) {
+  check_trainee(trainee);
+  SessionRecord r;
+  r.trainee = trainee;
+  r.drill = std::string(to_string(scenario.drill));
+  r.scenario_name =
+      scenario.name.empty() ? fs::path(scenario.source).stem().string() : scenario.name;
+  // The run ends now; it started the stepping and mesh-loading time ago (the report's own clock).
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  const double now = static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+  double took = 0;
+  for (const char* k : {"wall_time_s", "mesh_load_s"}) {
+    if (report.contains(k) && report[k].is_number() && std::isfinite(report[k].get<double>())) {
+      took += std::max(0.0, report[k].get<double>());
+    }
+  }
+  r.started_utc = format_utc(now - took);
+  r.finished_utc = format_utc(now);
+  r.recording = to_json(scenario);
+  // Settings: the recording less its tracks, names and drill (a column of its own) — eye,
+  // methods, seed, dt, duration and whatever the scenario format gains (difficulty), without a
+  // list to keep in step.
+  r.settings = r.recording;
+  for (const char* k : {"hands", "name", "description", "drill"}) r.settings.erase(k);
+  if (report.contains("metrics") && report["metrics"].is_object()) r.metrics = report["metrics"];
+  if (r.metrics.contains("score") && r.metrics["score"].is_number()) {
+    r.score = r.metrics["score"].get<double>();
+  }
+  if (report.contains("state_hash") && report["state_hash"].is_string()) {
+    r.state_hash = report["state_hash"].get<std::string>();
+  }
+  r.report = report.is_object() ? report : json::object();
+  make_parent_dir(db);
+  RecordStore store(db, OpenMode::CreateIfMissing);
+  return store.add_record(r);
+}
+
+}  // namespace phaco::cli

@@ -1,0 +1,77 @@
+#include "apps/phaco/report_command.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/phaco/commands.hpp"
+#include "engine/core/error.hpp"
+#include "procedures/report/html_report.hpp"
+
+namespace phaco::cli {
+
+namespace {
+
+// The file's modification time in UTC, for reports that carry no date of their own.
+std::string file_date(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto t = std::filesystem::last_write_time(path, ec);
+  if (ec) return {};
+  const auto sys = std::chrono::file_clock::to_sys(t);
+  const std::time_t tt = std::chrono::system_clock::to_time_t(sys);
+  std::tm tm{};
+  gmtime_r(&tt, &tm);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC (report file time)", &tm);
+  return buf;
+}
+
+}  // namespace
+
+int report(const std::vector<std::string>& args) {
+  std::string in, out;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--html") {
+      if (i + 1 >= args.size()) throw InputError("report: option --html needs a value");
+      out = args[++i];
+    } else if (args[i].rfind("--", 0) == 0) {
+      throw InputError("report: unknown option '" + args[i] + "' (try 'phaco --help')");
+    } else if (in.empty()) {
+      in = args[i];
+    } else {
+      throw InputError("report: unexpected argument '" + args[i] + "' (give one RUN.json)");
+    }
+  }
+  if (in.empty())
+    throw InputError("report: give the run report file (phaco report RUN.json --html OUT.html)");
+  if (out.empty()) throw InputError("report: --html OUT.html is required");
+
+  std::ifstream file(in);
+  if (!file) throw InputError(in + ": cannot open the run report");
+  nlohmann::json run;
+  try {
+    run = nlohmann::json::parse(file);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(in + ": not valid JSON (" + e.what() + ")");
+  }
+  if (run.is_object() && !run.contains("date")) {
+    if (const std::string d = file_date(in); !d.empty()) run["date"] = d;
+  }
+  std::string html;
+  try {
+    html = report::html_report(run);
+  } catch (const InputError& e) {
+    throw InputError(in + ": " + e.what());
+  }
+  std::ofstream page(out, std::ios::binary);
+  if (!page) throw InputError("report: cannot write '" + out + "'");
+  page << html;
+  if (!page.flush()) throw InputError("report: cannot write '" + out + "'");
+  std::printf("%s: wrote %s (%zu bytes)\n", in.c_str(), out.c_str(), html.size());
+  return kOk;
+}
+
+}  // namespace phaco::cli

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Regenerates the expert and novice drill scenarios (issue 7) in data/scenarios from the demos.
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+out="$here/../../data/scenarios"
+rhexis() { python3 "$here/capsulorhexis.py" "$@"; }
+sculpt() { python3 "$here/sculpting.py" "$@"; }
+
+rhexis "$out/capsulorhexis_expert.json" --scale 1.04 --name "capsulorhexis expert" \
+  --description "The demo's technique at a 5.3 mm circle: puncture near the centre, a short radial flap, four quarters with a regrasp after each; meets every rhexis target."
+rhexis "$out/capsulorhexis_novice_off_centre.json" --scale 1.04 --shift 0.7,0 --name "capsulorhexis novice: off centre" \
+  --description "The expert's tracks moved 0.7 mm toward 3 o'clock: the opening is the right size but decentred."
+rhexis "$out/capsulorhexis_novice_runout.json" --scale 1.04 --outward 5.3,6.5,0.45 --name "capsulorhexis novice: radial run-out" \
+  --description "The expert's tracks, but in the second quarter the forceps pull outward (radius growing by 45 %): the tear runs out radially."
+rhexis "$out/capsulorhexis_novice_small.json" --scale 0.9 --name "capsulorhexis novice: too small" \
+  --description "The demo's technique at a 4.4 mm circle: complete and round but too small."
+sculpt "$out/phaco_sculpting_expert.json" --name "phaco sculpting expert" \
+  --description "Divide and conquer as the demo: two trenches of four passes, two lanes each, a quarter turn between them."
+sculpt "$out/phaco_sculpting_novice_shallow.json" --passes 0.8,1.5 --name "phaco sculpting novice: shallow trenches" \
+  --description "Only the first two passes of each trench: the trenches are about 40 % of the nucleus deep."
+sculpt "$out/phaco_sculpting_novice_narrow.json" --lanes 0 --name "phaco sculpting novice: narrow trenches" \
+  --description "One lane per pass: the trenches are about one tip wide (0.8 mm), below 1.5 tip diameters."

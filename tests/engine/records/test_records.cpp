@@ -1,0 +1,381 @@
+// RecordStore: round trip, date order, schema checks, errors that name the file, transactions
+// that leave nothing behind, a writer killed mid-stream, and the XML/JSON export.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "engine/core/error.hpp"
+#include "engine/records/records.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using phaco::InputError;
+using phaco::OpenMode;
+using phaco::RecordStore;
+using phaco::SessionRecord;
+
+fs::path temp_db(const std::string& name) {
+  const fs::path d =
+      fs::temp_directory_path() / ("phaco-records-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d / "records.sqlite";
+}
+
+// The database's folder, removed when the test ends (a forked child leaves by _exit, not here).
+struct TempDb {
+  explicit TempDb(const std::string& name) : file(temp_db(name)) {}
+  ~TempDb() {
+    std::error_code ec;
+    fs::remove_all(file.parent_path(), ec);
+  }
+  fs::path file;
+};
+
+SessionRecord sample(const std::string& trainee, const std::string& started, double score) {
+  SessionRecord r;
+  r.trainee = trainee;
+  r.drill = "capsulorhexis";
+  r.scenario_name = "capsulorhexis demo";
+  r.started_utc = started;
+  r.finished_utc = started;  // same second: allowed
+  r.settings = {{"dt_s", 1.0 / 120.0}, {"seed", 7}, {"eye", {{"level", 2}}}};
+  r.metrics = {{"rhexis.diameter_mm", 5.25}, {"rhexis.complete", true}, {"score", score}};
+  r.score = score;
+  r.state_hash = "0123456789abcdef";
+  r.recording = {{"drill", "capsulorhexis"}, {"dt_s", 1.0 / 120.0}, {"hands", json::object()}};
+  r.report = {{"state_hash", "0123456789abcdef"}, {"frames", 10}};
+  return r;
+}
+
+// Raw SQL on the file, as another program (or a damaged disk) would touch it.
+void raw_sql(const fs::path& file, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.string().c_str(), &db), SQLITE_OK);
+  char* err = nullptr;
+  const int rc = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &err);
+  const std::string msg = err ? err : "";
+  sqlite3_free(err);
+  sqlite3_close(db);
+  ASSERT_EQ(rc, SQLITE_OK) << msg;
+}
+
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Records, RoundTripKeepsEveryField) {
+  const TempDb tmp("roundtrip");
+  const fs::path& file = tmp.file;
+  SessionRecord in = sample("Ana Ruiz", "2026-11-21T10:00:00.000Z", 81.5);
+  in.finished_utc = "2026-11-21T10:00:42.125Z";
+  int64_t id = 0;
+  {
+    RecordStore store(file);
+    id = store.add_record(in);
+    EXPECT_GT(id, 0);
+  }
+  const RecordStore store(file, OpenMode::ExistingOnly);  // reopened: it was on disk
+  const auto out = store.record(id);
+  ASSERT_TRUE(out.has_value());
+  EXPECT_EQ(out->id, id);
+  EXPECT_EQ(out->trainee, in.trainee);
+  EXPECT_EQ(out->drill, in.drill);
+  EXPECT_EQ(out->scenario_name, in.scenario_name);
+  EXPECT_EQ(out->started_utc, in.started_utc);
+  EXPECT_EQ(out->finished_utc, in.finished_utc);
+  EXPECT_EQ(out->settings, in.settings);  // doubles exact: 1/120 survives text
+  EXPECT_EQ(out->metrics, in.metrics);
+  ASSERT_TRUE(out->score.has_value());
+  EXPECT_EQ(*out->score, 81.5);
+  EXPECT_EQ(out->state_hash, in.state_hash);
+  EXPECT_EQ(out->recording, in.recording);
+  EXPECT_EQ(out->report, in.report);
+  EXPECT_FALSE(store.record(id + 1).has_value());
+  EXPECT_EQ(store.integrity_check(), "ok");
+
+  SessionRecord unscored = sample("Ana Ruiz", "2026-11-22T10:00:00.000Z", 0);
+  unscored.score.reset();
+  RecordStore writer(file);
+  const auto back = writer.record(writer.add_record(unscored));
+  ASSERT_TRUE(back.has_value());
+  EXPECT_FALSE(back->score.has_value());
+}
+
+TEST(Records, FileIsWalWithSchemaVersion) {
+  const TempDb tmp("wal");
+  const fs::path& file = tmp.file;
+  { RecordStore store(file); }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.string().c_str(), &db), SQLITE_OK);
+  auto pragma = [&](const char* sql) {
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(db, sql, -1, &s, nullptr);
+    std::string v;
+    if (sqlite3_step(s) == SQLITE_ROW) v = reinterpret_cast<const char*>(sqlite3_column_text(s, 0));
+    sqlite3_finalize(s);
+    return v;
+  };
+  EXPECT_EQ(pragma("PRAGMA journal_mode"), "wal");  // WAL is persistent in the file
+  EXPECT_EQ(pragma("PRAGMA user_version"), std::to_string(phaco::kRecordsSchemaVersion));
+  sqlite3_close(db);
+}
+
+TEST(Records, TraineeRecordsComeInDateOrder) {
+  const TempDb tmp("order");
+  const fs::path& file = tmp.file;
+  RecordStore store(file);
+  // Written out of order; read back by date, ties by id.
+  const int64_t c = store.add_record(sample("ana", "2026-11-23T09:00:00.000Z", 90));
+  const int64_t a = store.add_record(sample("ana", "2026-11-21T09:00:00.000Z", 60));
+  store.add_record(sample("ben", "2026-11-20T09:00:00.000Z", 10));
+  const int64_t b1 = store.add_record(sample("ana", "2026-11-22T09:00:00.000Z", 70));
+  const int64_t b2 = store.add_record(sample("ana", "2026-11-22T09:00:00.000Z", 75));
+  const auto rows = store.records_of("ana");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0].id, a);
+  EXPECT_EQ(rows[1].id, b1);
+  EXPECT_EQ(rows[2].id, b2);
+  EXPECT_EQ(rows[3].id, c);
+  for (const auto& r : rows) EXPECT_EQ(r.trainee, "ana");
+  EXPECT_TRUE(store.records_of("nobody").empty());
+  EXPECT_EQ(store.trainees(), (std::vector<std::string>{"ana", "ben"}));
+}
+
+TEST(Records, NewerSchemaVersionIsRefused) {
+  const TempDb tmp("version");
+  const fs::path& file = tmp.file;
+  { RecordStore store(file); }
+  raw_sql(file, "PRAGMA user_version = 7");
+  const std::string msg = error_of([&] { RecordStore store(file); });
+  EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("schema version 7 is newer"), std::string::npos) << msg;
+}
+
+TEST(Records, ForeignSqliteDatabaseIsRefused) {
+  const TempDb tmp("foreign");
+  const fs::path& file = tmp.file;
+  raw_sql(file, "CREATE TABLE photos(id INTEGER)");
+  const std::string msg = error_of([&] { RecordStore store(file); });
+  EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("not an OpenPhaco records database"), std::string::npos) << msg;
+}
+
+TEST(Records, NonDatabaseFileNamesFileAndProblem) {
+  const TempDb tmp("notadb");
+  const fs::path& file = tmp.file;
+  std::ofstream(file) << "this is a scenario, not a database\n" << std::string(4096, 'x');
+  const std::string msg = error_of([&] { RecordStore store(file); });
+  EXPECT_EQ(msg.rfind(file.string() + ": ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("not an SQLite database"), std::string::npos) << msg;
+
+  const fs::path missing = file.parent_path() / "missing.sqlite";
+  const std::string gone = error_of([&] { RecordStore store(missing, OpenMode::ExistingOnly); });
+  EXPECT_NE(gone.find(missing.string()), std::string::npos) << gone;
+  EXPECT_FALSE(fs::exists(missing)) << "history/export must not create a database";
+
+  const fs::path no_dir = file.parent_path() / "no" / "such" / "dir.sqlite";
+  const std::string cant = error_of([&] { RecordStore store(no_dir); });
+  EXPECT_NE(cant.find(no_dir.string()), std::string::npos) << cant;
+}
+
+TEST(Records, LockedDatabaseIsReportedNotHung) {
+  const TempDb tmp("locked");
+  const fs::path& file = tmp.file;
+  { RecordStore store(file); }
+  // Another connection holds the write lock; ours waits its busy timeout (100 ms here) and then
+  // reports the lock instead of hanging.
+  sqlite3* other = nullptr;
+  ASSERT_EQ(sqlite3_open(file.string().c_str(), &other), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(other, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+  RecordStore store(file, OpenMode::CreateIfMissing, 100);  // WAL readers do not wait for it
+  const std::string msg =
+      error_of([&] { store.add_record(sample("ana", "2026-01-01T00:00:00.000Z", 5)); });
+  sqlite3_exec(other, "ROLLBACK", nullptr, nullptr, nullptr);
+  sqlite3_close(other);
+  EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("locked"), std::string::npos) << msg;
+  EXPECT_TRUE(store.records_of("ana").empty());
+  // Once the other writer is gone the same store writes.
+  EXPECT_GT(store.add_record(sample("ana", "2026-01-01T00:00:00.000Z", 5)), 0);
+}
+
+TEST(Records, MalformedJsonInARowNamesRecordAndColumn) {
+  const TempDb tmp("badjson");
+  const fs::path& file = tmp.file;
+  int64_t id = 0;
+  {
+    RecordStore store(file);
+    id = store.add_record(sample("ana", "2026-11-21T09:00:00.000Z", 50));
+  }
+  raw_sql(file, "UPDATE records SET metrics = '{\"score\": 50,' WHERE id = " + std::to_string(id));
+  const RecordStore store(file);
+  const std::string msg = error_of([&] { store.record(id); });
+  EXPECT_NE(msg.find(file.string() + ": record " + std::to_string(id) + ", column 'metrics'"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(error_of([&] { store.records_of("ana"); }).find("column 'metrics'"), std::string::npos);
+
+  raw_sql(file, "UPDATE records SET metrics = '{}', settings = '[1, 2]' WHERE id = " +
+                    std::to_string(id));
+  const std::string not_object = error_of([&] { store.record(id); });
+  EXPECT_NE(not_object.find("column 'settings': expected a JSON object"), std::string::npos)
+      << not_object;
+}
+
+TEST(Records, FailedWriteRollsBackEverything) {
+  const TempDb tmp("rollback");
+  const fs::path& file = tmp.file;
+  RecordStore store(file);
+  store.add_record(sample("ana", "2026-11-21T09:00:00.000Z", 50));
+  // A new trainee's first record breaks the schema (score beyond 100) after the trainee row was
+  // inserted in the same transaction: the trainee must not remain.
+  const std::string msg =
+      error_of([&] { store.add_record(sample("carla", "2026-11-21T10:00:00.000Z", 150)); });
+  EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("CHECK constraint failed"), std::string::npos) << msg;
+  EXPECT_EQ(store.trainees(), std::vector<std::string>{"ana"});
+  EXPECT_TRUE(store.records_of("carla").empty());
+  // Finished before started is refused the same way.
+  SessionRecord backwards = sample("dan", "2026-11-21T10:00:00.000Z", 50);
+  backwards.finished_utc = "2026-11-21T09:59:59.000Z";
+  EXPECT_THROW(store.add_record(backwards), InputError);
+  EXPECT_EQ(store.trainees(), std::vector<std::string>{"ana"});
+  // And the store still works after a rollback.
+  EXPECT_GT(store.add_record(sample("carla", "2026-11-21T10:00:00.000Z", 99)), 0);
+  EXPECT_EQ(store.records_of("carla").size(), 1u);
+  EXPECT_EQ(store.records_of("ana").size(), 1u);
+}
+
+TEST(Records, WriterKilledMidStreamLeavesCommittedRecordsIntact) {
+  const TempDb tmp("kill");
+  const fs::path& file = tmp.file;
+  RecordStore(file).add_record(sample("ana", "2026-11-21T09:00:00.000Z", 42));
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // Writes big records as fast as it can until killed, so the kill lands mid-transaction
+    // (most of the time is spent inside one).
+    try {
+      RecordStore store(file);
+      SessionRecord r = sample("ben", "2026-11-22T09:00:00.000Z", 1);
+      r.report["padding"] = std::string(256 * 1024, 'p');
+      for (int i = 0; i < 100000; ++i) store.add_record(r);
+    } catch (...) {
+    }
+    _exit(3);
+  }
+  // Wait until the child has committed a few records, then kill it without warning.
+  int committed = 0;
+  for (int tries = 0; tries < 2000 && committed < 5; ++tries) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    try {
+      committed = static_cast<int>(RecordStore(file).records_of("ben").size());
+    } catch (const InputError&) {
+    }
+  }
+  ASSERT_EQ(kill(child, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer finished before it was killed";
+  ASSERT_GE(committed, 5);
+
+  RecordStore store(file);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  const auto ana = store.records_of("ana");
+  ASSERT_EQ(ana.size(), 1u);
+  EXPECT_EQ(*ana[0].score, 42);
+  const auto ben = store.records_of("ben");  // every row whole: all JSON columns parse
+  EXPECT_GE(ben.size(), static_cast<size_t>(committed));
+  for (const auto& r : ben) EXPECT_EQ(r.report["padding"].get<std::string>().size(), 256u * 1024u);
+  EXPECT_GT(store.add_record(sample("ana", "2026-11-23T09:00:00.000Z", 43)), 0);
+}
+
+TEST(Records, MetricUnitsComeFromTheNames) {
+  using phaco::metric_unit;
+  EXPECT_EQ(metric_unit("time_s"), "s");
+  EXPECT_EQ(metric_unit("incision.width_mm"), "mm");
+  EXPECT_EQ(metric_unit("incision.entry_angle_deg"), "deg");
+  EXPECT_EQ(metric_unit("incision.clock_hour"), "clock hour");
+  EXPECT_EQ(metric_unit("left.tool_speed_mm_s.mean"), "mm/s");
+  EXPECT_EQ(metric_unit("left.contact_force_mN.max"), "mN");
+  EXPECT_EQ(metric_unit("volume_removed_mm3"), "mm^3");
+  EXPECT_EQ(metric_unit("haptic_model.lens_stiffness_mn_mm"), "mN/mm");
+  EXPECT_EQ(metric_unit("score"), "points");
+  EXPECT_EQ(metric_unit("rhexis.circularity"), "1");
+  EXPECT_EQ(metric_unit("regrasps"), "1");
+  EXPECT_EQ(metric_unit("trench.depth_fraction"), "1");
+  EXPECT_EQ(metric_unit("eye.overrides.capsule.youngs_modulus_kpa"), "kPa");
+}
+
+TEST(Records, XmlExportEscapesAndListsEveryMetricWithUnit) {
+  SessionRecord r = sample("O'Brien <&> \"Jo\"", "2026-11-21T09:00:00.000Z", 77.25);
+  r.id = 12;
+  r.trainee += std::string("\x01\xff", 2);  // a control character and a byte that is not UTF-8
+  r.metrics["left.contact_force_mN.max"] = 12.5;
+  r.metrics["left.contact_force_mN.histogram"] = json::array({1, 2, 3});
+  const std::string xml = phaco::records_to_xml({r});
+  EXPECT_EQ(
+      xml.rfind("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<openphaco_records schema=\"1\">", 0),
+      0u);
+  EXPECT_NE(xml.find("<session id=\"12\">"), std::string::npos);
+  EXPECT_NE(
+      xml.find(
+          "<trainee>O&apos;Brien &lt;&amp;&gt; &quot;Jo&quot;\xEF\xBF\xBD\xEF\xBF\xBD</trainee>"),
+      std::string::npos)
+      << xml;
+  EXPECT_NE(
+      xml.find("<metric name=\"rhexis.diameter_mm\" unit=\"mm\" type=\"number\">5.25</metric>"),
+      std::string::npos)
+      << xml;
+  EXPECT_NE(xml.find("<metric name=\"rhexis.complete\" unit=\"1\" type=\"bool\">true</metric>"),
+            std::string::npos);
+  EXPECT_NE(
+      xml.find(
+          "<metric name=\"left.contact_force_mN.max\" unit=\"mN\" type=\"number\">12.5</metric>"),
+      std::string::npos);
+  EXPECT_NE(xml.find("type=\"array\">[1,2,3]</metric>"), std::string::npos);
+  EXPECT_NE(xml.find("<setting name=\"eye.level\" unit=\"1\" type=\"number\">2</setting>"),
+            std::string::npos);
+  EXPECT_NE(
+      xml.find("<setting name=\"dt_s\" unit=\"s\" type=\"number\">0.008333333333333333</setting>"),
+      std::string::npos)
+      << xml;
+  EXPECT_NE(xml.find("<score unit=\"points\">77.25</score>"), std::string::npos);
+  EXPECT_EQ(xml.find('\x01'), std::string::npos);
+  // Every metric appears once.
+  size_t count = 0;
+  for (size_t p = 0; (p = xml.find("<metric ", p)) != std::string::npos; ++p) ++count;
+  EXPECT_EQ(count, r.metrics.size());
+
+  const json j = phaco::record_to_json(r);
+  EXPECT_EQ(j["id"], 12);
+  EXPECT_EQ(j["score"], 77.25);
+  EXPECT_EQ(j["metrics"], r.metrics);
+  EXPECT_EQ(j["recording"], r.recording);
+}
+
+TEST(Records, UtcFormatSortsAsDates) {
+  EXPECT_EQ(phaco::format_utc(0), "1970-01-01T00:00:00.000Z");
+  EXPECT_EQ(phaco::format_utc(1795000000.9996), "2026-11-18T11:06:41.000Z");  // rounds up a second
+  EXPECT_LT(phaco::format_utc(1795000000.5), phaco::format_utc(1795000001.0));
+  EXPECT_EQ(phaco::utc_now().size(), 24u);
+}
+
+}  // namespace
