@@ -10,6 +10,7 @@
 // the last good pose (the tool freezes where it was) and write_force sends/keeps zero force.
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -60,6 +61,14 @@ struct DeviceCounters {
     return accepted + malformed + bad_checksum + wrong_version + wrong_peer + duplicate +
            out_of_order + stale;
   }
+};
+
+// Options of the devices that play a scenario track (scripted: interpolated; replay: as recorded).
+struct TrackDeviceOptions {
+  std::string name;                   // shown in reports; empty: the device's kind
+  DeviceLimits limits{};              // has_force: the loop computes and records forces
+  double hold_s = 0;                  // s, the last pose is held this long before Ended
+  std::size_t force_log_size = 4096;  // forces kept (the last N)
 };
 
 class Device {

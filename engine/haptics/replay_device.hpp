@@ -57,19 +57,16 @@ class DeviceRecorder {
   uint64_t dropped_ = 0, rejected_ = 0;
 };
 
-struct ReplayDeviceOptions {
-  std::string name = "replay";
-  DeviceLimits limits{};
-  double hold_s = 0;                  // s, the last sample is held this long before Ended
-  std::size_t force_log_size = 4096;  // forces kept (the last N)
-};
+using ReplayDeviceOptions = TrackDeviceOptions;
 
 class ReplayDevice final : public Device {
  public:
   // Throws InputError when the track is empty.
   explicit ReplayDevice(HandTrack track, ReplayDeviceOptions options = {});
 
-  std::string_view name() const override { return options_.name; }
+  std::string_view name() const override {
+    return options_.name.empty() ? "replay" : options_.name;
+  }
   DeviceLimits limits() const override { return options_.limits; }
   void start(int64_t now_ns) override;
   void stop() override { started_ = false; }

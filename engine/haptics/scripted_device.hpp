@@ -15,19 +15,17 @@
 
 namespace phaco {
 
-struct ScriptedDeviceOptions {
-  std::string name = "scripted";
-  DeviceLimits limits{};              // has_force: the loop computes and records forces
-  double hold_s = 0;                  // s, the last pose is held this long before Ended
-  std::size_t force_log_size = 4096;  // forces kept (the last N)
-};
+// Options shared with ReplayDevice (engine/haptics/device.hpp: TrackDeviceOptions).
+using ScriptedDeviceOptions = TrackDeviceOptions;
 
 class ScriptedDevice final : public Device {
  public:
   // Throws InputError when the track is empty.
   explicit ScriptedDevice(HandTrack track, ScriptedDeviceOptions options = {});
 
-  std::string_view name() const override { return options_.name; }
+  std::string_view name() const override {
+    return options_.name.empty() ? "scripted" : options_.name;
+  }
   DeviceLimits limits() const override { return options_.limits; }
   void start(int64_t now_ns) override;
   void stop() override { started_ = false; }

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "engine/core/markup.hpp"
 #include "engine/io/json_reader.hpp"
 #include "engine/records/records.hpp"
 
@@ -46,88 +47,6 @@ bool is_statistic(std::string_view seg) {
   return false;
 }
 
-// Appends `s` escaped for XML 1.0 text and attribute values. Invalid UTF-8 and the characters
-// XML 1.0 cannot carry at all (most C0 controls, U+FFFE/U+FFFF) become U+FFFD, so the file stays
-// well-formed whatever was typed as a trainee name.
-void append_escaped(std::string& out, std::string_view s) {
-  static constexpr std::string_view kReplacement = "\xEF\xBF\xBD";
-  size_t i = 0;
-  while (i < s.size()) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x80) {
-      switch (c) {
-        case '&':
-          out += "&amp;";
-          break;
-        case '<':
-          out += "&lt;";
-          break;
-        case '>':
-          out += "&gt;";
-          break;
-        case '"':
-          out += "&quot;";
-          break;
-        case '\'':
-          out += "&apos;";
-          break;
-        // Character references survive attribute-value normalisation, raw tabs/newlines do not.
-        case '\t':
-          out += "&#9;";
-          break;
-        case '\n':
-          out += "&#10;";
-          break;
-        case '\r':
-          out += "&#13;";
-          break;
-        default:
-          if (c < 0x20 || c == 0x7f) {
-            out += kReplacement;
-          } else {
-            out += static_cast<char>(c);
-          }
-      }
-      ++i;
-      continue;
-    }
-    // Multi-byte sequence: length from the lead byte, then continuation bytes and range checks.
-    int len = 0;
-    uint32_t cp = 0;
-    if (c >= 0xC2 && c <= 0xDF) {
-      len = 2, cp = c & 0x1F;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      len = 3, cp = c & 0x0F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      len = 4, cp = c & 0x07;
-    }
-    bool ok = len > 0 && i + static_cast<size_t>(len) <= s.size();
-    for (int k = 1; ok && k < len; ++k) {
-      const auto cc = static_cast<unsigned char>(s[i + static_cast<size_t>(k)]);
-      ok = (cc & 0xC0) == 0x80;
-      cp = (cp << 6) | (cc & 0x3F);
-    }
-    if (ok) {
-      const bool overlong = (len == 3 && cp < 0x800) || (len == 4 && cp < 0x10000);
-      const bool surrogate = cp >= 0xD800 && cp <= 0xDFFF;
-      ok = !overlong && !surrogate && cp <= 0x10FFFF && cp != 0xFFFE && cp != 0xFFFF;
-    }
-    if (ok) {
-      out.append(s.substr(i, static_cast<size_t>(len)));
-      i += static_cast<size_t>(len);
-    } else {
-      out += kReplacement;
-      ++i;
-    }
-  }
-}
-
-std::string escaped(std::string_view s) {
-  std::string out;
-  append_escaped(out, s);
-  return out;
-}
-
 std::string value_text(const json& v) {
   if (v.is_number_integer()) return v.dump();
   if (v.is_number_float()) return io::format_number(v.get<double>());
@@ -166,11 +85,11 @@ void write_values(std::string& out, const json& j, const char* tag, const char* 
     out += indent;
     out += "<";
     out += tag;
-    out += " name=\"" + escaped(name) + "\"";
+    out += " name=\"" + escape_markup(name) + "\"";
     if (value.is_number() || value.is_boolean())
-      out += " unit=\"" + escaped(metric_unit(name)) + "\"";
+      out += " unit=\"" + escape_markup(metric_unit(name)) + "\"";
     out += " type=\"" + value_type(value) + "\">";
-    append_escaped(out, value_text(value));
+    append_escaped_markup(out, value_text(value));
     out += "</";
     out += tag;
     out += ">\n";
@@ -182,7 +101,7 @@ void element(std::string& out, const char* indent, const char* tag, std::string_
   out += "<";
   out += tag;
   out += ">";
-  append_escaped(out, text);
+  append_escaped_markup(out, text);
   out += "</";
   out += tag;
   out += ">\n";

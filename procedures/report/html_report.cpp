@@ -1,5 +1,7 @@
 #include "procedures/report/html_report.hpp"
 
+#include "engine/core/markup.hpp"
+
 // Two passes: read() checks and copies every field the page uses into plain structs (so a wrong
 // type is reported before anything is drawn, with the field's JSON path), then the sections are
 // written from those structs. A missing field is never an error: its section says it is left out.
@@ -267,30 +269,7 @@ Run read(const json& j) {
 // Writing.
 
 std::string escape(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
+  return escape_markup(s);
 }
 
 std::string fmt(double v) {

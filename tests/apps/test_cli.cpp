@@ -1,4 +1,5 @@
-// The `phaco` executable as a user meets it: exit codes 0 / 2 / 1 and messages that name the problem.
+// The `phaco` executable as a user meets it: exit codes 0 / 2 / 1 and messages that name the
+// problem.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -8,30 +9,21 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/support/shell.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
+using Result = phaco::test::ShellResult;
 
 Result phaco(const std::string& args) {
-  const std::string cmd = std::string(PHACO_BIN) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) r.output.append(buf, n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return phaco::test::shell(std::string(PHACO_BIN) + " " + args);
 }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("phaco-cli-" + name + "-" + std::to_string(::getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("phaco-cli-" + name + "-" + std::to_string(::getpid()));
   fs::create_directories(d);
   return d;
 }
@@ -41,7 +33,8 @@ fs::path write(const fs::path& dir, const std::string& name, const std::string& 
   return dir / name;
 }
 
-const std::string kSmall = R"({ "drill": "capsulorhexis", "eye": { "level": 0 }, "dt_s": 0.01, "duration_s": 0.2,
+const std::string kSmall =
+    R"({ "drill": "capsulorhexis", "eye": { "level": 0 }, "dt_s": 0.01, "duration_s": 0.2,
   "hands": { "right": { "tool": "cystotome", "track": [ { "t": 0, "pos": [0, 0, 3.5], "quat": [1, 0, 0, 0] },
                                                       { "t": 0.2, "pos": [0, 0, 2], "quat": [1, 0, 0, 0] } ] } } })";
 
@@ -75,7 +68,8 @@ TEST(Cli, ValidateNamesFileAndField) {
   EXPECT_EQ(phaco("validate " + good.string()).code, 0);
   const Result r = phaco("validate " + good.string() + " " + bad.string());
   EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find("bad.json: drill: unknown drill 'capsulotomy'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bad.json: drill: unknown drill 'capsulotomy'"), std::string::npos)
+      << r.output;
   const Result missing = phaco("validate " + (dir / "nope.json").string());
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.output.find("nope.json"), std::string::npos);
@@ -86,9 +80,11 @@ TEST(Cli, RunWritesReportAndIsThreadIndependent) {
   const fs::path dir = temp_dir("run");
   const fs::path scen = write(dir, "small.json", kSmall);
   const std::string cache = " --cache-dir " + (dir / "cache").string();
-  const Result one = phaco("run " + scen.string() + " --threads 1 --report " + (dir / "r1.json").string() + cache);
+  const Result one =
+      phaco("run " + scen.string() + " --threads 1 --report " + (dir / "r1.json").string() + cache);
   ASSERT_EQ(one.code, 0) << one.output;
-  const Result two = phaco("run " + scen.string() + " --threads 2 --report " + (dir / "r2.json").string() + cache);
+  const Result two =
+      phaco("run " + scen.string() + " --threads 2 --report " + (dir / "r2.json").string() + cache);
   ASSERT_EQ(two.code, 0) << two.output;
   const auto r1 = nlohmann::json::parse(std::ifstream(dir / "r1.json"));
   const auto r2 = nlohmann::json::parse(std::ifstream(dir / "r2.json"));
@@ -101,7 +97,8 @@ TEST(Cli, RunWritesReportAndIsThreadIndependent) {
   EXPECT_EQ(nlohmann::json::parse(json.output)["state_hash"], r1["state_hash"]);
   EXPECT_EQ(phaco("run " + scen.string() + " --threads 0" + cache).code, 2);
   EXPECT_EQ(phaco("run " + scen.string() + " --threads many" + cache).code, 2);
-  const Result unwritable = phaco("run " + scen.string() + " --report /nonexistent-dir/r.json" + cache);
+  const Result unwritable =
+      phaco("run " + scen.string() + " --report /nonexistent-dir/r.json" + cache);
   EXPECT_EQ(unwritable.code, 2);
   EXPECT_NE(unwritable.output.find("/nonexistent-dir/r.json"), std::string::npos);
   fs::remove_all(dir);
@@ -122,7 +119,8 @@ TEST(Cli, MeshWritesEveryBody) {
   const fs::path dir = temp_dir("mesh");
   const Result r = phaco("mesh --level 0 --out " + dir.string());
   ASSERT_EQ(r.code, 0) << r.output;
-  for (const char* f : {"cornea.obj", "capsule.obj", "iris.obj", "globe.obj", "lens_surface.obj", "lens.node", "lens.ele"}) {
+  for (const char* f : {"cornea.obj", "capsule.obj", "iris.obj", "globe.obj", "lens_surface.obj",
+                        "lens.node", "lens.ele"}) {
     EXPECT_TRUE(fs::exists(dir / f)) << f;
     EXPECT_GT(fs::file_size(dir / f), 100u) << f;
   }

@@ -23,6 +23,7 @@
 #include "engine/io/scenario.hpp"
 #include "engine/records/records.hpp"
 #include "procedures/scene/run.hpp"
+#include "tests/support/shell.hpp"
 
 namespace {
 
@@ -32,22 +33,10 @@ using nlohmann::json;
 const fs::path kIncisionDemo =
     fs::path(PHACO_SOURCE_DIR) / "data/scenarios/corneal_incision_demo.json";
 
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
+using Result = phaco::test::ShellResult;
 
 Result phaco(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + (env.empty() ? "" : " ") + PHACO_BIN + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) r.output.append(buf, n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return phaco::test::shell(env + (env.empty() ? "" : " ") + PHACO_BIN + " " + args);
 }
 
 fs::path temp_dir(const std::string& name) {
