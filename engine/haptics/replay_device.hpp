@@ -65,7 +65,7 @@ class ReplayDevice final : public Device {
   explicit ReplayDevice(HandTrack track, ReplayDeviceOptions options = {});
 
   std::string_view name() const override {
-    return options_.name.empty() ? "replay" : options_.name;
+    return options_.name.empty() ? std::string_view("replay") : std::string_view(options_.name);
   }
   DeviceLimits limits() const override { return options_.limits; }
   void start(int64_t now_ns) override;

@@ -24,7 +24,8 @@ class ScriptedDevice final : public Device {
   explicit ScriptedDevice(HandTrack track, ScriptedDeviceOptions options = {});
 
   std::string_view name() const override {
-    return options_.name.empty() ? "scripted" : options_.name;
+    // Both arms as views: a std::string arm would make the result view a temporary.
+    return options_.name.empty() ? std::string_view("scripted") : std::string_view(options_.name);
   }
   DeviceLimits limits() const override { return options_.limits; }
   void start(int64_t now_ns) override;
