@@ -8,9 +8,11 @@
 #include <optional>
 
 #include "apps/phaco/args.hpp"
+#include "apps/phaco/haptic_record.hpp"
 #include "apps/phaco/records_commands.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
+#include "engine/core/utc_time.hpp"
 #include "engine/haptics/device_factory.hpp"
 #include "engine/io/scenario.hpp"
 #include "procedures/eye/eye_mesh.hpp"
@@ -42,16 +44,6 @@ double parse_seconds(const std::string& command, const std::string& option, cons
                      std::to_string(hi) + ", got '" + text + "'");
   }
   return value;
-}
-
-// "2026-11-21T19:30:00Z".
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 void write_text(const std::filesystem::path& path, const std::string& text) {
@@ -166,7 +158,10 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
         static_cast<int64_t>(parse_seconds("run", "--spin-us", *spin, 0, 1000) * 1e3);
   }
   HapticSession session(config);
-  session.attach(hand, make_device(spec, context));
+  // --record: the device's samples become the stored recording (apps/phaco/haptic_record.hpp).
+  const auto recording = HapticRecording::from_args(a, scenario, hand, spec_text);
+  auto device = make_device(spec, context);
+  session.attach(hand, recording ? recording->wrap(std::move(device)) : std::move(device));
   RealtimeRunOptions run;
   if (auto d = a.option("--duration"))
     run.duration_s = parse_seconds("run", "--duration", *d, 0.01, 86400);
@@ -180,6 +175,10 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
   j["device"] = spec_text;
   j["hand"] = std::string(to_string(hand));
   if (auto path = a.option("--report")) write_text(*path, j.dump(2) + "\n");
+  if (recording) {
+    recording->store(scenario, scene_options(a, "run"), j,
+                     run.duration_s > 0 ? run.duration_s : scenario.duration_s);
+  }
   if (a.flag("--json")) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -195,10 +194,12 @@ int run(const std::vector<std::string>& raw) {
   const Args a =
       parse_args("run", raw,
                  {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration",
-                  "--stall-at", "--stall-ms", "--spin-us", "--record", "--trainee"},
+                  "--stall-at", "--stall-ms", "--spin-us", "--record", "--trainee", "--difficulty"},
                  {"--json", "--no-rt"});
   if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
-  const Scenario scenario = load_scenario(a.positional[0]);
+  Scenario scenario = load_scenario(a.positional[0]);
+  // A level of the drill file (docs/drills.md); checked when the scene is built.
+  if (auto level = a.option("--difficulty")) scenario.difficulty = *level;
   if (auto spec = a.option("--haptics")) return run_with_haptics(a, scenario, *spec);
   for (const char* o : {"--hand", "--duration", "--stall-at", "--stall-ms", "--spin-us"}) {
     if (a.option(o)) throw InputError(std::string("run: ") + o + " needs --haptics");

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "apps/phaco/commands.hpp"
+#include "apps/phaco/compare_command.hpp"
 #include "apps/phaco/records_commands.hpp"
 #include "apps/phaco/report_command.hpp"
 #include "engine/core/error.hpp"
@@ -15,13 +16,16 @@ constexpr const char* kUsage = R"(phaco — OpenPhaco headless simulator
 
 usage:
   phaco run FILE [--threads N] [--report OUT.json] [--json] [--cache-dir DIR]
-                 [--record DB --trainee NAME]
+                 [--record DB --trainee NAME] [--difficulty LEVEL]
       Run a scenario headless for its duration at its fixed step; print a summary with the
       drill's metrics and 0-100 score (docs/scoring.md), or, with --json, the JSON report; write
       the JSON report to OUT.json; with --trainee, store the run in the records database
       (DB, default $PHACO_RECORDS_DB or ~/.local/share/openphaco/records.sqlite; docs/records.md).
+      --difficulty picks a level of the drill file (data/drills/<drill>.json, e.g. standard,
+      easy, hard; docs/drills.md) instead of the scenario's.
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
+                 [--record DB --trainee NAME]
       Run the scenario in real time with the 1 kHz haptic thread; DEVICE drives one hand's tool
       and feels the force of the local haptic model (docs/haptics.md):
         scripted[:left|right]            the scenario's own track for that hand, in real time
@@ -32,15 +36,21 @@ usage:
       it got it. --spin-us: the loop sleeps to the deadline minus this, then spins (default 60).
       --duration runs longer or shorter than the scenario (it restarts when it ends);
       --stall-at/--stall-ms make the simulation hang once, to show the force stays continuous.
+      --record stores the scenario with the track the device produced (docs/records.md).
   phaco validate FILE...
       Check scenario files; every problem is named by file, JSON path and what was expected.
   phaco mesh --level L --out DIR [--layout curvilinear|isotropic] [--no-tets] [--params FILE]
       Generate the standard eye's meshes at resolution level L (0..7, default eye level 3:
       about 8k capsule vertices, 50k lens tets) as OBJ and TetGen .node/.ele files.
-  phaco report RUN.json --html OUT.html
+  phaco report RUN.json --html OUT.html [--expert EXPERT.json]
       Write a run report (phaco run --report) as one self-contained HTML page: the score and its
       terms, every metric against its target, the events, and plots (force, speed, paths, the
-      rhexis against its target circle, the trench from above) (docs/report.md).
+      rhexis against its target circle, the trench from above) (docs/report.md); --expert adds
+      the comparison with an expert's run report.
+  phaco compare RUN.json EXPERT.json [--json OUT.json]
+      Compare a run report with an expert's: per hand, path distance, speed and force differences
+      after dynamic time warping of the tool paths, the time ratio, and run - expert per metric
+      (docs/compare.md).
   phaco history TRAINEE [--db DB] [--json]
       The trainee's recorded sessions in date order (drill, score, key metrics) and the trend.
   phaco export ID [--db DB] [--xml OUT] [--json OUT] [--scenario OUT]
@@ -84,6 +94,7 @@ int main(int argc, char** argv) {
     if (command == "mesh") return phaco::cli::mesh(args);
     if (command == "graph") return phaco::cli::graph(args);
     if (command == "report") return phaco::cli::report(args);
+    if (command == "compare") return phaco::cli::compare(args);
     if (command == "history") return phaco::cli::history(args);
     if (command == "export") return phaco::cli::export_record(args);
     std::fprintf(stderr, "phaco: unknown command '%s' (try 'phaco --help')\n", command.c_str());

@@ -9,6 +9,7 @@
 
 #include "apps/phaco/commands.hpp"
 #include "engine/core/error.hpp"
+#include "procedures/report/compare_section.hpp"
 #include "procedures/report/html_report.hpp"
 
 namespace phaco::cli {
@@ -32,11 +33,14 @@ std::string file_date(const std::filesystem::path& path) {
 }  // namespace
 
 int report(const std::vector<std::string>& args) {
-  std::string in, out;
+  std::string in, out, expert;  // --expert: docs/compare.md
   for (size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--html") {
       if (i + 1 >= args.size()) throw InputError("report: option --html needs a value");
       out = args[++i];
+    } else if (args[i] == "--expert") {
+      if (i + 1 >= args.size()) throw InputError("report: option --expert needs a value");
+      expert = args[++i];
     } else if (args[i].rfind("--", 0) == 0) {
       throw InputError("report: unknown option '" + args[i] + "' (try 'phaco --help')");
     } else if (in.empty()) {
@@ -60,9 +64,14 @@ int report(const std::vector<std::string>& args) {
   if (run.is_object() && !run.contains("date")) {
     if (const std::string d = file_date(in); !d.empty()) run["date"] = d;
   }
+  // Compared before the page is drawn, so a bad expert file fails with its own name.
+  const std::string compared =
+      expert.empty() ? std::string()
+                     : report::compare_section(compare::compare_reports(
+                           run, compare::read_report(expert), in, expert));
   std::string html;
   try {
-    html = report::html_report(run);
+    html = report::html_report(run, compared);
   } catch (const InputError& e) {
     throw InputError(in + ": " + e.what());
   }

@@ -1,5 +1,6 @@
 #include "engine/io/scenario.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -69,7 +70,8 @@ class ScenarioParser {
     }
     r_.expect_object(
         root, "$",
-        {"name", "description", "drill", "eye", "methods", "dt_s", "seed", "duration_s", "hands"});
+        {"name", "description", "drill", "drill_file", "difficulty", "eye", "methods", "dt_s", "seed",
+         "duration_s", "hands"});
     Scenario s;
     s.source = r_.source();
     if (const json* v = JsonReader::find(root, "name")) s.name = r_.string(*v, "name");
@@ -78,6 +80,10 @@ class ScenarioParser {
     }
     s.drill = static_cast<Drill>(
         choice(r_.require(root, "$", "drill", one_of(kDrillNames)), "drill", kDrillNames, "drill"));
+    if (const json* v = JsonReader::find(root, "drill_file")) {
+      s.drill_file = existing_file(*v, "drill_file", "drill file");
+    }
+    if (const json* v = JsonReader::find(root, "difficulty")) difficulty(*v, s);
     if (const json* v = JsonReader::find(root, "eye")) s.eye = eye(*v, "eye");
     if (const json* v = JsonReader::find(root, "methods")) s.methods = methods(*v, "methods");
 
@@ -144,6 +150,22 @@ class ScenarioParser {
       out[key] = r_.string(value, kpath);
     }
     return out;
+  }
+
+  // "difficulty": "hard" (a level of the drill file) or {"level"?: "hard", "patient_age_years": 85, ...}.
+  void difficulty(const json& v, Scenario& s) const {
+    if (v.is_string()) {
+      s.difficulty = r_.string(v, "difficulty");
+      if (s.difficulty.empty()) r_.fail("difficulty", "expected a level name, got an empty string");
+      return;
+    }
+    s.difficulty_settings = read_difficulty_settings(r_, v, "difficulty", {"level"});
+    if (const json* level = JsonReader::find(v, "level")) {
+      s.difficulty = r_.string(*level, "difficulty.level");
+      if (s.difficulty.empty()) {
+        r_.fail("difficulty.level", "expected a level name, got an empty string");
+      }
+    }
   }
 
   EyeSpec eye(const json& v, const std::string& path) const {
@@ -292,6 +314,53 @@ class ScenarioParser {
 
 }  // namespace
 
+DifficultySettings DifficultySettings::overlaid(const DifficultySettings& over) const {
+  DifficultySettings out = *this;
+  if (over.patient_age_years) out.patient_age_years = over.patient_age_years;
+  if (over.anterior_bowing_kpa) out.anterior_bowing_kpa = over.anterior_bowing_kpa;
+  if (over.anterior_chamber_depth_mm) out.anterior_chamber_depth_mm = over.anterior_chamber_depth_mm;
+  if (over.nucleus_hardness) out.nucleus_hardness = over.nucleus_hardness;
+  return out;
+}
+
+DifficultySettings read_difficulty_settings(const io::JsonReader& r, const json& v,
+                                            const std::string& path,
+                                            std::initializer_list<std::string_view> extra) {
+  struct Field {
+    std::string_view name;
+    double lo, hi;
+    std::optional<double> DifficultySettings::*member;
+  };
+  // Ranges: published adult values and the anomalies' extremes (docs/drills.md).
+  static constexpr Field kFields[] = {
+      {"patient_age_years", 1, 100, &DifficultySettings::patient_age_years},
+      {"anterior_bowing_kpa", 0, 2, &DifficultySettings::anterior_bowing_kpa},
+      {"anterior_chamber_depth_mm", 1.5, 4.5, &DifficultySettings::anterior_chamber_depth_mm},
+      {"nucleus_hardness", 0.05, 1, &DifficultySettings::nucleus_hardness}};
+  if (!v.is_object()) {
+    r.fail(path, "expected an object of difficulty settings (patient_age_years, "
+                 "anterior_bowing_kpa, anterior_chamber_depth_mm, nucleus_hardness), got " +
+                     io::describe_value(v));
+  }
+  for (const auto& [key, unused] : v.items()) {
+    bool known = std::find(extra.begin(), extra.end(), key) != extra.end();
+    for (const Field& f : kFields) known = known || f.name == key;
+    if (!known) {
+      std::string names;
+      for (const Field& f : kFields) names += std::string(names.empty() ? "" : ", ") + std::string(f.name);
+      for (std::string_view e : extra) names += ", " + std::string(e);
+      r.fail(path_key(path, key), "unknown difficulty setting; expected one of: " + names);
+    }
+  }
+  DifficultySettings out;
+  for (const Field& f : kFields) {
+    if (const json* x = JsonReader::find(v, f.name)) {
+      out.*f.member = r.number_in(*x, path_key(path, f.name), f.lo, f.hi);
+    }
+  }
+  return out;
+}
+
 std::string_view to_string(Drill drill) {
   return kDrillNames[static_cast<std::size_t>(drill)];
 }
@@ -322,7 +391,8 @@ bool operator==(const TrackSample& a, const TrackSample& b) {
 
 bool operator==(const Scenario& a, const Scenario& b) {
   return a.name == b.name && a.description == b.description && a.drill == b.drill &&
-         a.eye == b.eye && a.methods == b.methods && a.dt_s == b.dt_s && a.seed == b.seed && a.duration_s == b.duration_s &&
+         a.eye == b.eye && a.drill_file == b.drill_file && a.difficulty == b.difficulty &&
+         a.difficulty_settings == b.difficulty_settings && a.methods == b.methods && a.dt_s == b.dt_s && a.seed == b.seed && a.duration_s == b.duration_s &&
          a.hands == b.hands;
 }
 
@@ -373,6 +443,19 @@ json to_json(const Scenario& s) {
     json meshes = json::object();
     for (const auto& [body, file] : s.eye.meshes) meshes[body] = file.generic_string();
     eye["meshes"] = std::move(meshes);
+  }
+  if (s.drill_file) j["drill_file"] = s.drill_file->generic_string();
+  const DifficultySettings& d = s.difficulty_settings;
+  if (d == DifficultySettings{}) {
+    if (!s.difficulty.empty()) j["difficulty"] = s.difficulty;
+  } else {
+    json dj = json::object();
+    if (!s.difficulty.empty()) dj["level"] = s.difficulty;
+    if (d.patient_age_years) dj["patient_age_years"] = *d.patient_age_years;
+    if (d.anterior_bowing_kpa) dj["anterior_bowing_kpa"] = *d.anterior_bowing_kpa;
+    if (d.anterior_chamber_depth_mm) dj["anterior_chamber_depth_mm"] = *d.anterior_chamber_depth_mm;
+    if (d.nucleus_hardness) dj["nucleus_hardness"] = *d.nucleus_hardness;
+    j["difficulty"] = std::move(dj);
   }
   j["eye"] = std::move(eye);
   if (!s.methods.empty()) j["methods"] = s.methods;

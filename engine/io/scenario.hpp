@@ -6,6 +6,7 @@
 // found".
 #include <cstdint>
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -53,6 +54,18 @@ struct EyeSpec {
   bool operator==(const EyeSpec&) const = default;
 };
 
+// A patient's difficulty settings (issue 7 item 1; seed 004 §1's anomalies), each optional;
+// procedures/eye/difficulty turns them into eye parameters (docs/drills.md).
+struct DifficultySettings {
+  std::optional<double> patient_age_years;          // [1, 100]: capsule modulus and strength
+  std::optional<double> anterior_bowing_kpa;        // [0, 2]: posterior (vitreous) pressure
+  std::optional<double> anterior_chamber_depth_mm;  // [1.5, 4.5]: lens pole to corneal endothelium
+  std::optional<double> nucleus_hardness;           // [0.05, 1]: soft .. brunescent
+  bool operator==(const DifficultySettings&) const = default;
+  // `over`'s present fields replace these.
+  DifficultySettings overlaid(const DifficultySettings& over) const;
+};
+
 struct Scenario {
   std::string source;  // file path as given, for messages; not part of equality
   std::string name, description;
@@ -61,6 +74,11 @@ struct Scenario {
   // the scene builder checks the names.
   std::map<std::string, std::string> methods;
   EyeSpec eye;
+  // The drill file (data/drills/<drill>.json unless given, resolved and absolute) and the
+  // difficulty: a level of that file ("" = its default) and explicit settings over it.
+  std::optional<std::filesystem::path> drill_file;
+  std::string difficulty;
+  DifficultySettings difficulty_settings;
   double dt_s = 1.0 / 120.0;  // s, fixed simulation step
   uint64_t seed = 0;
   double duration_s = 0;         // s
@@ -72,6 +90,15 @@ struct Scenario {
   const HandTrack* find_hand(Hand hand) const;
 };
 bool operator==(const Scenario& a, const Scenario& b);
+
+namespace io {
+class JsonReader;
+}
+// Reads the four difficulty settings from the object `v` at `path`, whose other allowed keys are
+// `extra` (e.g. "level"); shared by scenarios and drill files. Throws InputError.
+DifficultySettings read_difficulty_settings(const io::JsonReader& reader, const nlohmann::json& v,
+                                            const std::string& path,
+                                            std::initializer_list<std::string_view> extra);
 
 // Reads, parses and validates a scenario file; relative paths inside resolve against its
 // directory. Throws InputError.

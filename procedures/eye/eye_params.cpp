@@ -78,15 +78,18 @@ const std::vector<std::string_view>& required_eye_keys() {
                                                      "tools.phaco_tip_diameter_mm",
                                                      "tools.keratome_width_mm",
                                                      "tools.cystotome_tip_mm",
-                                                     "targets.rhexis_diameter_min_mm",
-                                                     "targets.rhexis_diameter_max_mm",
-                                                     "targets.rhexis_decentration_max_mm",
-                                                     "targets.incision_width_min_mm",
-                                                     "targets.incision_width_max_mm",
-                                                     "targets.trench_width_min_mm",
-                                                     "targets.trench_width_max_mm",
-                                                     "targets.trench_depth_fraction",
-                                                     "targets.trench_crossing_angle_deg"};
+                                                     "tool_eye.hand_stiffness_mn_mm",
+                                                     "tool_eye.hand_rotational_stiffness_mn_mm_per_rad",
+                                                     "tool_eye.tunnel_stiffness_mn_mm",
+                                                     "tool_eye.tunnel_rotational_stiffness_mn_mm_per_rad",
+                                                     "tool_eye.tunnel_free_angle_deg",
+                                                     "tool_eye.tunnel_length_mm",
+                                                     "tool_eye.entry_angle_deg",
+                                                     "tool_eye.port_inset_mm",
+                                                     "tool_eye.side_port_width_mm",
+                                                     "tool_eye.cornea_stiffness_mn_mm",
+                                                     "tool_eye.lens_stiffness_mn_mm",
+                                                     "tool_eye.globe_rotational_stiffness_mn_mm_per_rad"};
   return keys;
 }
 

@@ -53,7 +53,7 @@ struct IncisionResult {
   double advance_mm = 0.0;      // how far the tip went
   uint32_t frames = 0;          // advancing frames (withdrawal not counted)
   uint32_t cutting_frames = 0;  // advancing frames in which a cut path changed the mesh
-  uint32_t segments = 0;        // segments that changed the mesh, all four paths
+  uint64_t segments = 0;        // segments that changed the mesh, all four paths
   bool finished = false;        // the finishing samples changed the mesh
   double finish_ms = 0.0;       // their wall time
   uint32_t triangles_before = 0, triangles_after = 0;       // live

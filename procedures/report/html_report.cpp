@@ -835,7 +835,7 @@ std::string base64_encode(std::span<const std::uint8_t> bytes) {
   return out;
 }
 
-std::string html_report(const json& run) {
+std::string html_report(const json& run, const std::string& extra_sections) {
   const Run r = read(run);
   std::string title = "OpenPhaco report";
   if (!r.drill.empty()) title += " — " + r.drill;
@@ -847,6 +847,7 @@ std::string html_report(const json& run) {
   page += metrics_section(r);
   page += events_section(r);
   page += plots_section(r);
+  page += extra_sections;
   page +=
       "<footer>" +
       note(

@@ -25,8 +25,9 @@
 namespace phaco::report {
 
 // The whole page (UTF-8 HTML5). Throws InputError when `run` is not an object or a field has the
-// wrong type; never for a missing field.
-std::string html_report(const nlohmann::json& run);
+// wrong type; never for a missing field. `extra_sections` (HTML, e.g. compare_section.hpp's) goes
+// after the plots, before the footer.
+std::string html_report(const nlohmann::json& run, const std::string& extra_sections = {});
 
 // RFC 4648 base64 with padding, for the inlined images.
 std::string base64_encode(std::span<const std::uint8_t> bytes);

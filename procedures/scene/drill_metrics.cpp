@@ -14,9 +14,12 @@
 #include "procedures/rhexis/opening.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/cornea_cutting.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
 #include "procedures/scene/scene.hpp"
+#include "procedures/scene/tool_ports.hpp"
 #include "systems/deform/spring_law.hpp"
+#include "systems/grasp/grasp.hpp"
 #include "systems/haptic_model/haptic_model.hpp"
 #include "systems/metrics/metrics.hpp"
 
@@ -25,6 +28,7 @@ namespace phaco {
 namespace {
 
 constexpr uint32_t kHistogramBins = 20;
+constexpr double kClosedGrip = grasp::GraspSettings{}.close_at;  // forceps closed, as systems/grasp
 
 struct DrillEvent {
   double t_s = 0;
@@ -68,6 +72,8 @@ struct DrillRecord {
   std::vector<double> t_s;
   std::vector<DrillEvent> events;
   size_t tear_events_seen = 0;
+  std::optional<Vec3> first_grasp;  // where forceps first closed (grasp.offset_mm)
+  std::optional<Vec3> puncture;     // the cystotome's tip when it first cut the capsule
 };
 
 Anatomy anatomy_of(const eye::EyeParams& p) {
@@ -125,6 +131,9 @@ void sample_hand(Scene& scene, DrillRecord& r, int index, double t, double dt_s)
   const Vec3 p = pose.pos;
   const Vec3 previous = h.pos.empty() ? p : h.pos.back();
   const double speed = metrics::add_position(h.kinematics, p, dt_s);
+
+  // Where forceps first close, on tissue or not: grasp.offset_mm from the drill's grasp site.
+  if (h.kind == ToolKind::Forceps && !r.first_grasp && pose.grip >= kClosedGrip) r.first_grasp = p;
 
   // Grasp events from the forceps' capsule grasp state (systems/grasp's hysteresis).
   double force = 0.0;
@@ -201,6 +210,10 @@ void sample_tear(Scene& scene, DrillRecord& r, double t) {
   if (!capsule) return;
   const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
   if (!cc) return;
+  if (!r.puncture && cc->cut_segments > 0) {
+    for (const HandRecord& h : r.hands)
+      if (h.kind == ToolKind::Cystotome) r.puncture = scene.world.at<ToolState>(h.tool).pos;
+  }
   const tear::TearState& ts = cc->tear_state;
   int holder = -1;
   for (size_t i = 0; i < r.hands.size(); ++i)
@@ -241,14 +254,9 @@ double depth_fraction(const lens::NucleusShape& n, const Anatomy& a, const Vec3&
   return top > bottom ? (top - c.z()) / (top - bottom) : 0.0;
 }
 
-struct Term {
-  const char* metric;
-  double weight;
-  double falloff;  // distance outside the band at which the term reaches 0 (for counts: how many)
-};
-
-void score(DrillReport& out, std::initializer_list<Term> terms) {
-  for (const Term& t : terms) {
+// The drill file's score terms (docs/scoring.md) against the targets in `out`.
+void score(DrillReport& out, std::span<const ScoreTerm> terms) {
+  for (const ScoreTerm& t : terms) {
     const nlohmann::json value =
         out.metrics.contains(t.metric) ? out.metrics[t.metric] : nlohmann::json();
     const nlohmann::json target =
@@ -303,19 +311,14 @@ void hand_metrics(const Scene& scene, const DrillRecord& r, DrillReport& out,
 }
 
 void capsulorhexis_metrics(Scene& scene, const DrillRecord& r, DrillReport& out) {
-  const eye::EyeParams& p = scene.params;
   uint64_t grasps = 0, lens = 0;
   for (const HandRecord& h : r.hands) grasps += h.grasps, lens += h.lens_contacts;
   out.metrics["regrasps"] = grasps > 0 ? grasps - 1 : 0;  // the first grasp is not a regrasp
   out.metrics["lens_contacts"] = lens;
-  out.targets["lens_contacts"] = band(std::nullopt, 0.0);
-  out.targets["rhexis.complete"] = band(1.0, std::nullopt);
-  out.targets["rhexis.diameter_mm"] =
-      band(p.get("targets.rhexis_diameter_min_mm"), p.get("targets.rhexis_diameter_max_mm"));
-  out.targets["rhexis.centering_mm"] =
-      band(std::nullopt, p.get("targets.rhexis_decentration_max_mm"));
-  out.targets["rhexis.circularity"] = band(0.9, std::nullopt);  // the drill's: 1 is a circle
-  out.targets["rhexis.radial_tearouts"] = band(std::nullopt, 0.0);
+  if (r.puncture && scene.drill.guidance.puncture_site_mm) {
+    out.metrics["rhexis.puncture_offset_mm"] =
+        (*r.puncture - *scene.drill.guidance.puncture_site_mm).norm();
+  }
   const auto capsule = scene.body(BodyPart::Capsule);
   const CapsuleCutting* cc = capsule ? scene.world.get<CapsuleCutting>(*capsule) : nullptr;
   if (!cc) {
@@ -345,31 +348,24 @@ void capsulorhexis_metrics(Scene& scene, const DrillRecord& r, DrillReport& out)
   out.metrics["rhexis.ellipse_axis_ratio"] = o.ellipse_axis_ratio;
   nlohmann::json outline = nlohmann::json::array();
   for (const auto& q : o.outline_mm) outline.push_back({q[0], q[1]});
-  out.series["rhexis"] = {
-      {"outline_mm", std::move(outline)},
-      {"target_diameter_mm",
-       {p.get("targets.rhexis_diameter_min_mm"), p.get("targets.rhexis_diameter_max_mm")}},
-      {"target_centre_mm", {0.0, 0.0}}};
+  out.series["rhexis"] = {{"outline_mm", std::move(outline)}};
+  if (out.targets.contains("rhexis.diameter_mm")) {
+    const nlohmann::json& d = out.targets["rhexis.diameter_mm"];
+    out.series["rhexis"]["target_diameter_mm"] = {d.value("min", 0.0), d.value("max", 0.0)};
+  }
+  const auto& circle = scene.drill.guidance.rhexis_circle;
+  out.series["rhexis"]["target_centre_mm"] = {circle ? circle->centre_mm.x() : 0.0,
+                                              circle ? circle->centre_mm.y() : 0.0};
 }
 
 void sculpting_metrics(Scene& scene, const DrillRecord& r, DrillReport& out) {
-  const eye::EyeParams& p = scene.params;
   uint64_t breaches = 0, iris = 0;
   for (const HandRecord& h : r.hands) breaches += h.capsule_breaches, iris += h.iris_contacts;
   out.metrics["capsule_breach"] = breaches > 0 ? 1 : 0;
   out.metrics["iris_contacts"] = iris;
-  out.targets["capsule_breach"] = band(std::nullopt, 0.0);
-  out.targets["iris_contacts"] = band(std::nullopt, 0.0);
-  out.targets["trench.count"] = band(2.0, std::nullopt);
-  const double depth = p.get("targets.trench_depth_fraction");
-  const double angle = p.get("targets.trench_crossing_angle_deg");
-  const nlohmann::json width =
-      band(p.get("targets.trench_width_min_mm"), p.get("targets.trench_width_max_mm"));
-  out.targets["trench.width_mm"] = width;
-  // "About 80 %": ±0.1, rounded so that 0.8 − 0.1 reads 0.7.
-  const auto tidy = [](double v) { return std::round(v * 1e9) / 1e9; };
-  out.targets["trench.depth_fraction"] = band(tidy(depth - 0.1), tidy(depth + 0.1));
-  out.targets["trench.crossing_angle_deg"] = band(angle - 10.0, angle + 10.0);
+  // Each trench is held to the drill's trench targets.
+  const nlohmann::json width = out.targets.value("trench.width_mm", nlohmann::json::object());
+  const nlohmann::json depth = out.targets.value("trench.depth_fraction", nlohmann::json::object());
   const auto lens = scene.body(BodyPart::Lens);
   const LensSculpting* ls = lens ? scene.world.get<LensSculpting>(*lens) : nullptr;
   if (!ls) return;
@@ -385,7 +381,7 @@ void sculpting_metrics(Scene& scene, const DrillRecord& r, DrillReport& out) {
       out.metrics[key + ".width_mm"] = tr.trenches[i].width_mm;
       out.metrics[key + ".depth_fraction"] = tr.trenches[i].depth_fraction;
       out.targets[key + ".width_mm"] = width;
-      out.targets[key + ".depth_fraction"] = out.targets["trench.depth_fraction"];
+      out.targets[key + ".depth_fraction"] = depth;
       w += tr.trenches[i].width_mm, d += tr.trenches[i].depth_fraction;
     }
     out.metrics["trench.width_mm"] = w / double(tr.trenches.size());
@@ -438,7 +434,8 @@ SystemDesc drill_metrics_system(Scene& scene) {
   return {
       .name = "drill_metrics",
       .phase = Phase::Metrics,
-      .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.physics", "lens.tets"},
+      .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.physics", "lens.tets",
+                "tools.ports"},
       .writes = {"metrics"},
       .after = {},
       .run = [&scene](const FrameContext& ctx) {
@@ -449,6 +446,11 @@ SystemDesc drill_metrics_system(Scene& scene) {
         for (size_t i = 0; i < rec->hands.size(); ++i)
           sample_hand(scene, *rec, static_cast<int>(i), t, ctx.dt_s);
         sample_tear(scene, *rec, t);
+        // The tool pressing its corneal port beyond the threshold (tool_ports.hpp; ports on only).
+        for (size_t i = 0; i < rec->hands.size(); ++i) {
+          if (double f = 0; port_stress_began(scene, i, f))
+            push_event(*rec, t, "port_stress", static_cast<int>(i), "force_mN", f);
+        }
       }};
 }
 
@@ -460,7 +462,11 @@ DrillReport drill_report(Scene& scene) {
   uint64_t stress = 0;
   for (const HandRecord& h : r->hands) stress += h.corneal_stress;
   out.metrics["corneal_stress_events"] = stress;
-  out.targets["corneal_stress_events"] = band(std::nullopt, 0.0);
+  // Targets are the drill file's (data/drills); the per-trench ones derive from them.
+  for (const auto& [name, b] : scene.drill.targets) out.targets[name] = band(b.min, b.max);
+  if (r->first_grasp && scene.drill.guidance.grasp_site_mm) {
+    out.metrics["grasp.offset_mm"] = (*r->first_grasp - *scene.drill.guidance.grasp_site_mm).norm();
+  }
 
   const auto idx = metrics::decimation_indices(r->t_s.size(), metrics::kMaxSeriesSamples);
   out.series["t_s"] = metrics::decimate<double>(r->t_s, idx);
@@ -469,34 +475,20 @@ DrillReport drill_report(Scene& scene) {
   switch (scene.scenario.drill) {
     case Drill::Capsulorhexis:
       capsulorhexis_metrics(scene, *r, out);
-      score(out, {{"rhexis.complete", 25, 1},
-                  {"rhexis.diameter_mm", 20, 1.0},
-                  {"rhexis.centering_mm", 15, 0.6},
-                  {"rhexis.circularity", 10, 0.2},
-                  {"rhexis.radial_tearouts", 15, 1},
-                  {"lens_contacts", 5, 5},
-                  {"corneal_stress_events", 10, 3}});
       break;
     case Drill::PhacoSculpting:
       sculpting_metrics(scene, *r, out);
-      score(out, {{"trench.count", 10, 2},
-                  {"trench.width_mm", 20, 0.5},
-                  {"trench.depth_fraction", 20, 0.3},
-                  {"trench.crossing_angle_deg", 15, 30},
-                  {"capsule_breach", 20, 1},
-                  {"iris_contacts", 5, 3},
-                  {"corneal_stress_events", 10, 3}});
       break;
     case Drill::CornealIncision: {
       uint64_t iris = 0;
       for (const HandRecord& h : r->hands) iris += h.iris_contacts;
       out.metrics["iris_contacts"] = iris;
-      out.targets["iris_contacts"] = band(std::nullopt, 0.0);
-      // The scene does not cut the cornea yet: no wound to measure, so only the safety terms.
-      score(out, {{"corneal_stress_events", 60, 3}, {"iris_contacts", 40, 3}});
+      incision_metrics(scene, out);  // the wound on the cut cornea (cornea_cutting.hpp)
       break;
     }
   }
+  ports_metrics(scene, out.metrics);  // globe rotation, port force (ports on only)
+  score(out, scene.drill.scoring);
   out.metrics["score"] = out.score;
 
   for (const DrillEvent& e : r->events) {

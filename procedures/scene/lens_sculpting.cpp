@@ -15,6 +15,8 @@
 namespace phaco {
 namespace {
 
+constexpr double kStandardHardness = 0.5;  // data/eye/standard_eye.json lens_model.nucleus_hardness
+
 constexpr double kKgPerMm3PerKgPerM3 = 1e-9;
 constexpr double kPi = 3.14159265358979323846;
 
@@ -97,6 +99,10 @@ void add_lens_sculpting(Scene& scene) {
                      ": eye lens_model.ultrasound_power must be in (0, 1], got " +
                      std::to_string(ls.ultrasound_power));
   }
+  // A harder nucleus yields less to the same ultrasound (issue 7's difficulty, docs/drills.md):
+  // above the standard hardness 0.5 the effective power falls as 0.5 / hardness (a brunescent
+  // nucleus, hardness 1, takes half the power's reach); softer nuclei cannot exceed the set power.
+  ls.ultrasound_power *= std::min(1.0, kStandardHardness / params.get("lens_model.nucleus_hardness"));
   const double f = params.get("lens.nucleus_fraction");
   ls.nucleus = {f * 0.5 * params.get("lens.equatorial_diameter_mm"),
                 f * params.get("lens.anterior_half_thickness_mm"),

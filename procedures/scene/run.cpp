@@ -41,6 +41,7 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
   r.wall_time_s = wall.elapsed_s();
   r.scenario = scenario.source;
   r.drill = std::string(to_string(scenario.drill));
+  r.drill_setup = drill_setup_json(*scene);
   r.frames = frames;
   r.sim_time_s = scene->time_s;
   r.threads = scene->executor->threads();
@@ -73,6 +74,7 @@ nlohmann::json to_json(const RunReport& r) {
   nlohmann::json j;
   j["scenario"] = r.scenario;
   j["drill"] = r.drill;
+  j["drill_setup"] = r.drill_setup;
   j["sim_time_s"] = r.sim_time_s;
   j["dt_s"] = r.dt_s;
   j["frames"] = r.frames;

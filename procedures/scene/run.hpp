@@ -18,6 +18,8 @@ struct SystemCost {
 struct RunReport {
   std::string scenario;  // file
   std::string drill;
+  // The drill file and the patient settings the difficulty resolved to (docs/drills.md).
+  nlohmann::json drill_setup = nlohmann::json::object();
   double sim_time_s = 0;
   uint64_t frames = 0;
   int threads = 1;

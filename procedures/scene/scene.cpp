@@ -11,14 +11,17 @@
 #include "engine/core/error.hpp"
 #include "engine/core/state_hash.hpp"
 #include "engine/io/mesh_obj.hpp"
+#include "procedures/eye/difficulty.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
+#include "procedures/scene/cornea_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
+#include "procedures/scene/tool_ports.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
 
 namespace phaco {
@@ -31,9 +34,15 @@ std::vector<std::string> to_strings(std::span<const char* const> names) {
   return {names.begin(), names.end()};
 }
 
-eye::EyeParams load_params(const Scenario& s) {
+// Eye file, then the drill's difficulty, then the scenario's explicit overrides (they win).
+eye::EyeParams load_params(const Scenario& s, const DifficultySettings& difficulty) {
   eye::EyeParams params =
       s.eye.params_file ? eye::load_eye_params(*s.eye.params_file) : eye::default_eye_params();
+  try {
+    eye::apply_difficulty(params, difficulty);
+  } catch (const InputError& e) {
+    throw InputError(s.source + ": difficulty: " + e.what());
+  }
   for (const auto& [key, value] : s.eye.overrides) {
     try {
       eye::apply_override(params, key, value);
@@ -151,6 +160,29 @@ void replace_meshes_from_files(const Scenario& s, eye::EyeMeshes& meshes) {
   }
 }
 
+BodyPart body_part(std::string_view name) {
+  for (BodyPart p : {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::Globe,
+                     BodyPart::LensSurface, BodyPart::Lens}) {
+    if (to_string(p) == name) return p;
+  }
+  throw InputError("unknown body '" + std::string(name) + "'");  // drill files are checked on load
+}
+
+// Each hand's tool must be one the drill gives that hand.
+void check_tools(const Scenario& s, const DrillFile& d) {
+  for (const HandTrack& h : s.hands) {
+    const auto& allowed = h.hand == Hand::Left ? d.left_tools : d.right_tools;
+    if (std::find(allowed.begin(), allowed.end(), h.tool) != allowed.end()) continue;
+    std::string names;
+    for (ToolKind t : allowed) names += (names.empty() ? "" : ", ") + std::string(to_string(t));
+    throw InputError(s.source + ": hands." + std::string(to_string(h.hand)) + ".tool: the " +
+                     std::string(to_string(s.drill)) + " drill (" + d.source + ") gives the " +
+                     std::string(to_string(h.hand)) + " hand " +
+                     (names.empty() ? std::string("no tool") : names) + "; got " +
+                     std::string(to_string(h.tool)));
+  }
+}
+
 bool is_lens_method(const std::string& key) {
   return key == "lens.model" || key == "lens.broadphase" || key == "lens.narrowphase";
 }
@@ -162,12 +194,13 @@ void check_methods(const Scenario& s, const std::vector<BodyPart>& parts) {
   };
   for (const auto& [key, value] : s.methods) {
     const bool capsule = is_capsule_method(key), lens = is_lens_method(key);
+    if (is_ports_method(key)) continue;  // any drill; the value is checked by ports_mode
     if (!capsule && !lens) {
       throw InputError(
           s.source + ": methods[\"" + key +
           "\"]: unknown method setting; expected one of: capsule.integrator, capsule.spring_law, "
           "capsule.stiffness, capsule.pretension, capsule.active_set, capsule.cutting, "
-          "capsule.tear_rule, lens.model, lens.broadphase, lens.narrowphase");
+          "capsule.tear_rule, lens.model, lens.broadphase, lens.narrowphase, tools.ports");
     }
     if (capsule && !has(BodyPart::Capsule)) {
       throw InputError(s.source + ": methods[\"" + key + "\"]: the " +
@@ -206,16 +239,35 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
 
 }  // namespace
 
-std::vector<BodyPart> bodies_for(Drill drill) {
-  switch (drill) {
-    case Drill::CornealIncision:
-      return {BodyPart::Cornea, BodyPart::Iris, BodyPart::Globe};
-    case Drill::Capsulorhexis:
-      return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::LensSurface};
-    case Drill::PhacoSculpting:
-      return {BodyPart::Cornea, BodyPart::Capsule, BodyPart::Iris, BodyPart::Lens};
+DrillFile load_drill_for(const Scenario& s) {
+  if (s.drill_file) return load_drill_file(*s.drill_file);  // checked to exist on load
+  const std::filesystem::path file =
+      eye::data_dir() / "drills" / (std::string(to_string(s.drill)) + ".json");
+  if (!std::filesystem::exists(file)) {
+    throw InputError(s.source + ": drill: no drill file for '" + std::string(to_string(s.drill)) +
+                     "' at " + file.string() + " (give \"drill_file\" or set PHACO_DATA_DIR)");
   }
-  return {};
+  DrillFile d = load_drill_file(file);
+  if (d.drill != s.drill) {
+    throw InputError(d.source + ": drill: is '" + std::string(to_string(d.drill)) +
+                     "', but the scenario " + s.source + " is '" + std::string(to_string(s.drill)) +
+                     "'");
+  }
+  return d;
+}
+
+nlohmann::json drill_setup_json(const Scene& scene) {
+  const DifficultySettings& d = scene.difficulty;
+  nlohmann::json settings = nlohmann::json::object();
+  if (d.patient_age_years) settings["patient_age_years"] = *d.patient_age_years;
+  if (d.anterior_bowing_kpa) settings["anterior_bowing_kpa"] = *d.anterior_bowing_kpa;
+  if (d.anterior_chamber_depth_mm) settings["anterior_chamber_depth_mm"] = *d.anterior_chamber_depth_mm;
+  if (d.nucleus_hardness) settings["nucleus_hardness"] = *d.nucleus_hardness;
+  return {{"file", scene.drill.source},
+          {"title", scene.drill.title},
+          {"difficulty", scene.scenario.difficulty.empty() ? scene.drill.default_difficulty
+                                                           : scene.scenario.difficulty},
+          {"settings", std::move(settings)}};
 }
 
 std::optional<Entity> Scene::body(BodyPart part) const {
@@ -228,12 +280,22 @@ std::optional<Entity> Scene::body(BodyPart part) const {
 std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions& options) {
   auto scene = std::make_unique<Scene>();
   scene->scenario = scenario;
-  scene->params = load_params(scenario);
+  scene->drill = load_drill_for(scenario);
+  if (scene->drill.drill != scenario.drill) {
+    throw InputError(scenario.source + ": drill_file: " + scene->drill.source + " is a '" +
+                     std::string(to_string(scene->drill.drill)) + "' drill; the scenario is '" +
+                     std::string(to_string(scenario.drill)) + "'");
+  }
+  check_tools(scenario, scene->drill);
+  scene->difficulty = resolve_difficulty(scene->drill, scenario.difficulty,
+                                         scenario.difficulty_settings, scenario.source);
+  scene->params = load_params(scenario, scene->difficulty);
   scene->resolution = eye::resolution_for_level(scenario.eye.level);
   scene->commands = CommandQueues(options.threads);
   scene->haptics = options.haptics;
 
-  const auto parts = bodies_for(scenario.drill);
+  std::vector<BodyPart> parts;
+  for (const std::string& name : scene->drill.bodies) parts.push_back(body_part(name));
   check_methods(scenario, parts);
   const bool need_tets = std::find(parts.begin(), parts.end(), BodyPart::Lens) != parts.end();
   const auto layout = scenario.eye.capsule_layout == "isotropic" ? eye::CapsuleLayout::Isotropic
@@ -255,6 +317,8 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   }
 
   std::vector<SystemDesc> systems = base_systems(*scene);
+  // Tools in the corneal ports turning the globe (issue 7 item 2); none when "tools.ports" is off.
+  if (auto ports = tool_ports_system(*scene)) systems.push_back(std::move(*ports));
   if (scene->body(BodyPart::Capsule)) {
     add_capsule_physics(*scene);
     systems.push_back(capsule_dynamics_system(*scene));
@@ -269,6 +333,8 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
       systems.push_back(lens_sculpt_system(*scene));
     }
   }
+  // The keratome cuts the cornea (issue 7, corneal incision).
+  if (add_cornea_cutting(*scene)) systems.push_back(cornea_cut_system(*scene));
   if (scene->haptics) systems.push_back(haptic_publish_system(*scene));
   systems.push_back(drill_metrics_system(*scene));  // last: it only reads (issue 7 item 3)
   if (options.extra_systems) {

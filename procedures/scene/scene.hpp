@@ -2,7 +2,8 @@
 // A scene: the World a drill needs (bodies of the eye, tools with their tracks), its per-frame
 // task graph and the executor that runs it. Built once from a scenario; stepped at the fixed dt.
 //
-// Which bodies a drill loads (model no more than the scene needs, DESIGN.md §3):
+// Which bodies a drill loads is its drill file's "scene.bodies" (data/drills; model no more than
+// the scene needs, DESIGN.md §3):
 //   corneal_incision: cornea, iris, globe              (no lens at all)
 //   capsulorhexis:    cornea, capsule, iris, lens_surface
 //   phaco_sculpting:  cornea, capsule, iris, lens (tetrahedra)
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "components/body.hpp"
 #include "engine/ecs/command_buffer.hpp"
 #include "engine/ecs/world.hpp"
+#include "engine/io/drill_file.hpp"
 #include "engine/io/scenario.hpp"
 #include "engine/schedule/executor.hpp"
 #include "engine/schedule/frame_graph.hpp"
@@ -40,7 +43,9 @@ struct SceneOptions {
 
 struct Scene {
   Scenario scenario;
-  eye::EyeParams params;
+  DrillFile drill;                // its drill file (data/drills, docs/drills.md)
+  DifficultySettings difficulty;  // the level's settings with the scenario's over them
+  eye::EyeParams params;          // eye file, then difficulty, then the scenario's overrides
   eye::Resolution resolution;
   World world;
   std::vector<Entity> bodies;  // in creation order
@@ -56,7 +61,12 @@ struct Scene {
   std::optional<Entity> body(BodyPart part) const;
 };
 
-std::vector<BodyPart> bodies_for(Drill drill);
+// The scenario's drill file: its "drill_file", else eye::data_dir()/drills/<drill>.json. Throws
+// InputError naming the scenario and the file.
+DrillFile load_drill_for(const Scenario& scenario);
+
+// {"file", "title", "difficulty": level, "settings": {...}} for the run report.
+nlohmann::json drill_setup_json(const Scene& scene);
 
 // Throws InputError naming the scenario file and field for bad eye parameters or mesh files.
 std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions& options);

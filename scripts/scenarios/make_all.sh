@@ -20,3 +20,10 @@ sculpt "$out/phaco_sculpting_novice_shallow.json" --passes 0.8,1.5 --name "phaco
   --description "Only the first two passes of each trench: the trenches are about 40 % of the nucleus deep."
 sculpt "$out/phaco_sculpting_novice_narrow.json" --lanes 0 --name "phaco sculpting novice: narrow trenches" \
   --description "One lane per pass: the trenches are about one tip wide (0.8 mm), below 1.5 tip diameters."
+incision() { python3 "$here/incision.py" "$@"; }
+incision "$out/corneal_incision_expert.json" --name "corneal incision expert" \
+  --description "A straight keratome pass at 3 o'clock, 0.5 mm inside the limbus, 28 degrees below the corneal surface: a 1.7 mm tunnel into the anterior chamber; meets every incision target."
+incision "$out/corneal_incision_novice_steep.json" --angle 60 --name "corneal incision novice: too steep" \
+  --description "The expert's pass at 60 degrees below the corneal surface: the same site and width, but the tunnel is under 1 mm (a leaking wound)."
+incision "$out/corneal_incision_novice_site.json" --limbus 1.6 --name "corneal incision novice: too far inside the limbus" \
+  --description "The expert's pass started 1.6 mm inside the limbus: a good tunnel, but in the clear cornea away from the limbus."

@@ -9,26 +9,19 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "tests/support/shell.hpp"
+#include "tests/apps/cli.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using phaco::test::phaco;
+using phaco::test::read_text;
+using phaco::test::temp_dir;
+using phaco::test::write_text;
 
 using Result = phaco::test::ShellResult;
 
-Result phaco(const std::string& args) {
-  return phaco::test::shell(std::string(PHACO_BIN) + " " + args);
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("phaco-cli-" + name + "-" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
-
-fs::path write(const fs::path& dir, const std::string& name, const std::string& text) {
+fs::path write_text(const fs::path& dir, const std::string& name, const std::string& text) {
   std::ofstream(dir / name) << text;
   return dir / name;
 }
@@ -61,10 +54,10 @@ TEST(Cli, UsageErrorsAreBadInput) {
 
 TEST(Cli, ValidateNamesFileAndField) {
   const fs::path dir = temp_dir("validate");
-  const fs::path good = write(dir, "good.json", kSmall);
+  const fs::path good = write_text(dir, "good.json", kSmall);
   std::string bad_text = kSmall;
   bad_text.replace(bad_text.find("capsulorhexis"), 13, "capsulotomy");
-  const fs::path bad = write(dir, "bad.json", bad_text);
+  const fs::path bad = write_text(dir, "bad.json", bad_text);
   EXPECT_EQ(phaco("validate " + good.string()).code, 0);
   const Result r = phaco("validate " + good.string() + " " + bad.string());
   EXPECT_EQ(r.code, 2) << r.output;
@@ -78,7 +71,7 @@ TEST(Cli, ValidateNamesFileAndField) {
 
 TEST(Cli, RunWritesReportAndIsThreadIndependent) {
   const fs::path dir = temp_dir("run");
-  const fs::path scen = write(dir, "small.json", kSmall);
+  const fs::path scen = write_text(dir, "small.json", kSmall);
   const std::string cache = " --cache-dir " + (dir / "cache").string();
   const Result one =
       phaco("run " + scen.string() + " --threads 1 --report " + (dir / "r1.json").string() + cache);
@@ -108,7 +101,7 @@ TEST(Cli, RunRejectsBadScenarioWithExitTwo) {
   const fs::path dir = temp_dir("runbad");
   std::string text = kSmall;
   text.replace(text.find("\"t\": 0.2"), 8, "\"t\": -1.0");
-  const fs::path scen = write(dir, "unsorted.json", text);
+  const fs::path scen = write_text(dir, "unsorted.json", text);
   const Result r = phaco("run " + scen.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("unsorted.json: hands.right.track[1].t"), std::string::npos) << r.output;
@@ -129,7 +122,7 @@ TEST(Cli, MeshWritesEveryBody) {
 
 TEST(Cli, GraphPrintsDot) {
   const fs::path dir = temp_dir("graph");
-  const fs::path scen = write(dir, "small.json", kSmall);
+  const fs::path scen = write_text(dir, "small.json", kSmall);
   const Result r = phaco("graph " + scen.string() + " --cache-dir " + (dir / "cache").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("digraph"), std::string::npos);

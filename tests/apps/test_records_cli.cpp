@@ -23,29 +23,21 @@
 #include "engine/io/scenario.hpp"
 #include "engine/records/records.hpp"
 #include "procedures/scene/run.hpp"
-#include "tests/support/shell.hpp"
+#include "tests/apps/cli.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using phaco::test::phaco;
+using phaco::test::read_text;
+using phaco::test::temp_dir;
+using phaco::test::write_text;
 
 const fs::path kIncisionDemo =
     fs::path(PHACO_SOURCE_DIR) / "data/scenarios/corneal_incision_demo.json";
 
 using Result = phaco::test::ShellResult;
-
-Result phaco(const std::string& args, const std::string& env = "") {
-  return phaco::test::shell(env + (env.empty() ? "" : " ") + PHACO_BIN + " " + args);
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("phaco-records-cli-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 // Meshes shared by every test of this executable (generated once, then loaded).
 fs::path cache_dir() {
@@ -71,13 +63,6 @@ const auto* const kCacheCleanup = testing::AddGlobalTestEnvironment(new CacheCle
 json read_json(const fs::path& file) {
   std::ifstream in(file);
   return json::parse(in);
-}
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // Minimal well-formedness: one root, tags balanced and properly nested, attribute values quoted,

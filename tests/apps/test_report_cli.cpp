@@ -15,33 +15,18 @@
 #include <sstream>
 #include <string>
 
-#include "tests/support/shell.hpp"
+#include "tests/apps/cli.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using phaco::test::phaco;
+using phaco::test::read_text;
+using phaco::test::temp_dir;
+using phaco::test::write_text;
 
 using Result = phaco::test::ShellResult;
 using phaco::test::shell;
-
-Result phaco(const std::string& args) {
-  return shell(std::string(PHACO_BIN) + " " + args);
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("phaco-report-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 const fs::path kFixture = fs::path(PHACO_SOURCE_DIR) / "tests/apps/data/report_fixture.json";
 
@@ -60,7 +45,7 @@ TEST(ReportCli, WritesTheHtmlPage) {
   const Result r = phaco("report " + kFixture.string() + " --html " + out.string());
   ASSERT_EQ(r.code, 0) << r.output;
   ASSERT_TRUE(fs::exists(out));
-  const std::string html = read(out);
+  const std::string html = read_text(out);
   EXPECT_NE(html.find(">90<small>/100</small>"), std::string::npos);
   size_t images = 0;
   for (size_t at = html.find("data:image/png;base64,"); at != std::string::npos;

@@ -12,6 +12,7 @@
 #include "engine/core/error.hpp"
 #include "engine/io/scenario.hpp"
 #include "engine/io/track.hpp"
+#include "tests/support/expect_invalid.hpp"
 
 namespace phaco {
 namespace {
@@ -22,17 +23,7 @@ const fs::path kSourceDir = PHACO_SOURCE_DIR;
 const fs::path kScenarioDir = kSourceDir / "data/scenarios";
 const fs::path kBadDir = kSourceDir / "tests/engine/io/bad_scenarios";
 
-// The InputError message of `fn`, or a failure when it does not throw one.
-template <typename Fn>
-std::string error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an InputError";
-  return {};
-}
+using phaco::test::input_error_of;
 
 Quat quat_about(const Vec3& axis, double angle) {
   return Quat(Eigen::AngleAxisd(angle, axis.normalized()));
@@ -214,7 +205,7 @@ const std::vector<BadCase> kBadCases = {
      {"unknown_hand.json: hands.middle: unknown hand 'middle'; expected one of: left, right"}},
     {"unknown_field_root.json",
      {"unknown_field_root.json: seeds: unknown field 'seeds'; expected one of: name, description, "
-      "drill, eye, methods, dt_s, seed, duration_s, hands"}},
+      "drill, drill_file, difficulty, eye, methods, dt_s, seed, duration_s, hands"}},
     {"unknown_field_eye.json",
      {"unknown_field_eye.json: eye.levle: unknown field 'levle'; expected one of: level, "
       "capsule_layout, overrides, params, meshes"}},
@@ -339,7 +330,7 @@ TEST(Scenario, BadFilesFailWithPreciseMessages) {
   for (const BadCase& c : kBadCases) {
     SCOPED_TRACE(c.file);
     const fs::path file = kBadDir / c.file;
-    const std::string message = error_of([&] { load_scenario(file); });
+    const std::string message = input_error_of([&] { load_scenario(file); });
     // FILE as given comes first.
     EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0u) << message;
     std::size_t from = 0;
@@ -353,26 +344,26 @@ TEST(Scenario, BadFilesFailWithPreciseMessages) {
 
 TEST(Scenario, MissingFileAndDirectory) {
   const fs::path missing = kBadDir / "does_not_exist.json";
-  EXPECT_EQ(error_of([&] { load_scenario(missing); }),
+  EXPECT_EQ(input_error_of([&] { load_scenario(missing); }),
             missing.string() + ": scenario file not found");
-  EXPECT_EQ(error_of([&] { load_scenario(kBadDir); }),
+  EXPECT_EQ(input_error_of([&] { load_scenario(kBadDir); }),
             kBadDir.string() + ": is a directory; expected a scenario JSON file");
 }
 
 TEST(Scenario, SyntaxErrorPositionIsLineAndColumn) {
   const std::string text = "{\n  \"drill\": \"capsulorhexis\",\n  \"duration_s\": 5x\n}";
-  const std::string message = error_of([&] { parse_scenario(text, "s.json", "."); });
+  const std::string message = input_error_of([&] { parse_scenario(text, "s.json", "."); });
   EXPECT_EQ(message.rfind("s.json: line 3, column 18: ", 0), 0u) << message;
   EXPECT_EQ(message.find("json.exception"), std::string::npos) << message;
   // Unterminated input points past the last character.
-  const std::string cut = error_of([&] { parse_scenario("{\n \"drill\": ", "c.json", "."); });
+  const std::string cut = input_error_of([&] { parse_scenario("{\n \"drill\": ", "c.json", "."); });
   EXPECT_EQ(cut.rfind("c.json: line 2, column 11: ", 0), 0u) << cut;
 }
 
 TEST(Scenario, DuplicateKeyDeepInTrackNamesItsPath) {
   const std::string text = R"({"drill": "capsulorhexis", "duration_s": 5, "hands": {"left":
       {"tool": "forceps", "track": [{"t": 0, "pos": [0, 0, 3]}, {"t": 1, "t": 2, "pos": [0, 0, 3]}]}}})";
-  EXPECT_EQ(error_of([&] { parse_scenario(text, "d.json", "."); }),
+  EXPECT_EQ(input_error_of([&] { parse_scenario(text, "d.json", "."); }),
             "d.json: hands.left.track[1].t: duplicate field 't' (each field may appear only once)");
 }
 

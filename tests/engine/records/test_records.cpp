@@ -14,6 +14,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/records/records.hpp"
+#include "tests/support/expect_invalid.hpp"
 
 namespace {
 
@@ -70,15 +71,7 @@ void raw_sql(const fs::path& file, const std::string& sql) {
   ASSERT_EQ(rc, SQLITE_OK) << msg;
 }
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using phaco::test::input_error_of;
 
 TEST(Records, RoundTripKeepsEveryField) {
   const TempDb tmp("roundtrip");
@@ -163,7 +156,7 @@ TEST(Records, NewerSchemaVersionIsRefused) {
   const fs::path& file = tmp.file;
   { RecordStore store(file); }
   raw_sql(file, "PRAGMA user_version = 7");
-  const std::string msg = error_of([&] { RecordStore store(file); });
+  const std::string msg = input_error_of([&] { RecordStore store(file); });
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
   EXPECT_NE(msg.find("schema version 7 is newer"), std::string::npos) << msg;
 }
@@ -172,7 +165,7 @@ TEST(Records, ForeignSqliteDatabaseIsRefused) {
   const TempDb tmp("foreign");
   const fs::path& file = tmp.file;
   raw_sql(file, "CREATE TABLE photos(id INTEGER)");
-  const std::string msg = error_of([&] { RecordStore store(file); });
+  const std::string msg = input_error_of([&] { RecordStore store(file); });
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
   EXPECT_NE(msg.find("not an OpenPhaco records database"), std::string::npos) << msg;
 }
@@ -181,17 +174,18 @@ TEST(Records, NonDatabaseFileNamesFileAndProblem) {
   const TempDb tmp("notadb");
   const fs::path& file = tmp.file;
   std::ofstream(file) << "this is a scenario, not a database\n" << std::string(4096, 'x');
-  const std::string msg = error_of([&] { RecordStore store(file); });
+  const std::string msg = input_error_of([&] { RecordStore store(file); });
   EXPECT_EQ(msg.rfind(file.string() + ": ", 0), 0u) << msg;
   EXPECT_NE(msg.find("not an SQLite database"), std::string::npos) << msg;
 
   const fs::path missing = file.parent_path() / "missing.sqlite";
-  const std::string gone = error_of([&] { RecordStore store(missing, OpenMode::ExistingOnly); });
+  const std::string gone =
+      input_error_of([&] { RecordStore store(missing, OpenMode::ExistingOnly); });
   EXPECT_NE(gone.find(missing.string()), std::string::npos) << gone;
   EXPECT_FALSE(fs::exists(missing)) << "history/export must not create a database";
 
   const fs::path no_dir = file.parent_path() / "no" / "such" / "dir.sqlite";
-  const std::string cant = error_of([&] { RecordStore store(no_dir); });
+  const std::string cant = input_error_of([&] { RecordStore store(no_dir); });
   EXPECT_NE(cant.find(no_dir.string()), std::string::npos) << cant;
 }
 
@@ -206,7 +200,7 @@ TEST(Records, LockedDatabaseIsReportedNotHung) {
   ASSERT_EQ(sqlite3_exec(other, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
   RecordStore store(file, OpenMode::CreateIfMissing, 100);  // WAL readers do not wait for it
   const std::string msg =
-      error_of([&] { store.add_record(sample("ana", "2026-01-01T00:00:00.000Z", 5)); });
+      input_error_of([&] { store.add_record(sample("ana", "2026-01-01T00:00:00.000Z", 5)); });
   sqlite3_exec(other, "ROLLBACK", nullptr, nullptr, nullptr);
   sqlite3_close(other);
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
@@ -226,15 +220,16 @@ TEST(Records, MalformedJsonInARowNamesRecordAndColumn) {
   }
   raw_sql(file, "UPDATE records SET metrics = '{\"score\": 50,' WHERE id = " + std::to_string(id));
   const RecordStore store(file);
-  const std::string msg = error_of([&] { store.record(id); });
+  const std::string msg = input_error_of([&] { store.record(id); });
   EXPECT_NE(msg.find(file.string() + ": record " + std::to_string(id) + ", column 'metrics'"),
             std::string::npos)
       << msg;
-  EXPECT_NE(error_of([&] { store.records_of("ana"); }).find("column 'metrics'"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { store.records_of("ana"); }).find("column 'metrics'"),
+            std::string::npos);
 
   raw_sql(file, "UPDATE records SET metrics = '{}', settings = '[1, 2]' WHERE id = " +
                     std::to_string(id));
-  const std::string not_object = error_of([&] { store.record(id); });
+  const std::string not_object = input_error_of([&] { store.record(id); });
   EXPECT_NE(not_object.find("column 'settings': expected a JSON object"), std::string::npos)
       << not_object;
 }
@@ -247,7 +242,7 @@ TEST(Records, FailedWriteRollsBackEverything) {
   // A new trainee's first record breaks the schema (score beyond 100) after the trainee row was
   // inserted in the same transaction: the trainee must not remain.
   const std::string msg =
-      error_of([&] { store.add_record(sample("carla", "2026-11-21T10:00:00.000Z", 150)); });
+      input_error_of([&] { store.add_record(sample("carla", "2026-11-21T10:00:00.000Z", 150)); });
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
   EXPECT_NE(msg.find("CHECK constraint failed"), std::string::npos) << msg;
   EXPECT_EQ(store.trainees(), std::vector<std::string>{"ana"});

@@ -14,18 +14,12 @@
 #include "procedures/eye/eye_geometry.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/eye/resolution.hpp"
+#include "tests/support/expect_invalid.hpp"
 
 namespace phaco::eye {
 namespace {
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
+using phaco::test::input_error_of;
 
 TEST(EyeParams, StandardEyeHasDesignValues) {
   const EyeParams p = default_eye_params();
@@ -36,7 +30,9 @@ TEST(EyeParams, StandardEyeHasDesignValues) {
   EXPECT_DOUBLE_EQ(p.get("capsule.radius_mm"), 4.5);
   EXPECT_DOUBLE_EQ(p.get("cornea.posterior_apex_z_mm"), 4.8);
   EXPECT_DOUBLE_EQ(p.get("globe.axial_length_mm"), 23.5);
-  EXPECT_DOUBLE_EQ(p.get("targets.trench_crossing_angle_deg"), 90);
+  EXPECT_DOUBLE_EQ(p.get("tools.keratome_width_mm"), 2.4);
+  // Targets are the drills' (data/drills), not the eye's.
+  EXPECT_EQ(p.values.count("targets.trench_crossing_angle_deg"), 0u);
   EXPECT_EQ(p.values.size(), required_eye_keys().size());
 }
 
@@ -95,11 +91,11 @@ TEST(EyeParams, LoadRejectsBadFilesNamingFileAndPath) {
     edited.replace(at, std::string(c.from).size(), c.to);
     const auto file = dir.path() / (std::string(c.name) + ".json");
     std::ofstream(file) << edited;
-    const std::string msg = error_of([&] { load_eye_params(file); });
+    const std::string msg = input_error_of([&] { load_eye_params(file); });
     EXPECT_NE(msg.find(file.string()), std::string::npos) << c.name << ": " << msg;
     EXPECT_NE(msg.find(c.expect), std::string::npos) << c.name << ": " << msg;
   }
-  const std::string missing = error_of([&] { load_eye_params(dir.path() / "absent.json"); });
+  const std::string missing = input_error_of([&] { load_eye_params(dir.path() / "absent.json"); });
   EXPECT_NE(missing.find("absent.json"), std::string::npos) << missing;
 }
 
@@ -108,7 +104,7 @@ TEST(EyeParams, OverrideAcceptsKnownPositiveFiniteValues) {
   apply_override(p, "capsule.youngs_modulus_kpa", 3000);
   EXPECT_DOUBLE_EQ(p.get("capsule.youngs_modulus_kpa"), 3000);
 
-  const std::string unknown = error_of([&] { apply_override(p, "capsule.stiffness", 1.0); });
+  const std::string unknown = input_error_of([&] { apply_override(p, "capsule.stiffness", 1.0); });
   EXPECT_NE(unknown.find("unknown eye parameter 'capsule.stiffness'"), std::string::npos)
       << unknown;
   EXPECT_NE(unknown.find("capsule.youngs_modulus_kpa"), std::string::npos) << "lists known keys";
@@ -125,7 +121,7 @@ TEST(EyeParams, GeometryRejectsInconsistentEyes) {
   EyeParams p = default_eye_params();
   EXPECT_NO_THROW(eye_geometry(p));
   apply_override(p, "capsule.radius_mm", 5.0);  // wider than the lens (a = 4.7)
-  const std::string msg = error_of([&] { eye_geometry(p); });
+  const std::string msg = input_error_of([&] { eye_geometry(p); });
   EXPECT_NE(msg.find("capsule.radius_mm"), std::string::npos) << msg;
 
   EyeParams q = default_eye_params();

@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "components/tool.hpp"
@@ -231,7 +233,12 @@ TEST(DrillMetrics, CornealIncisionDemoHasKinematicsAndNoStress) {
   // The keratome enters at the limbus and withdraws through its own wound.
   EXPECT_EQ(r.metrics["corneal_stress_events"], 0);
   EXPECT_EQ(r.metrics["iris_contacts"], 0);
-  EXPECT_DOUBLE_EQ(r.score, 100.0);
+  // The demo's pass is steep (60° to the cornea): it loses exactly the wound-architecture terms.
+  std::set<std::string> lost;
+  for (const auto& t : r.score_terms)
+    if (t["points"].get<double>() < t["weight"].get<double>()) lost.insert(t["metric"]);
+  EXPECT_EQ(lost, (std::set<std::string>{"incision.entry_angle_deg", "incision.tunnel_length_mm"}));
+  EXPECT_LT(r.score, 100.0);
 }
 
 TEST(DrillMetrics, RunReportCarriesTheDrillReport) {
@@ -243,14 +250,21 @@ TEST(DrillMetrics, RunReportCarriesTheDrillReport) {
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["metrics"]["score"], r.metrics["score"]);
   EXPECT_EQ(j["targets"]["corneal_stress_events"]["max"].get<double>(), 0.0);
-  EXPECT_EQ(j["score_terms"].size(), 2u);
+  const DrillFile drill = load_drill_for(test::repo_scenario("corneal_incision_demo.json"));
+  EXPECT_EQ(j["score_terms"].size(), drill.scoring.size()) << "one term per drill-file term";
   EXPECT_TRUE(j["series"]["hands"].contains("right"));
   const std::string text = summary_text(r);
-  EXPECT_NE(text.find("score 100.0 / 100"), std::string::npos) << text;
+  char score[32];
+  std::snprintf(score, sizeof score, "score %.1f / 100", r.metrics["score"].get<double>());
+  EXPECT_NE(text.find(score), std::string::npos) << text;
   EXPECT_NE(text.find("right.path_length_mm"), std::string::npos) << text;
 }
 
 TEST(DrillMetrics, SameForOneAndTwoThreadsAndTheReportChangesNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "thread-count determinism is the Release pass's check; under ASan the same code "
+                  "runs in CapsulorhexisDemoMatchesTheSceneAndTheContract";
+#endif
   DemoRun& one = demo("capsulorhexis_demo.json", 1);
   DemoRun& two = demo("capsulorhexis_demo.json", 2);
   EXPECT_EQ(one.report.metrics, two.report.metrics);

@@ -61,11 +61,33 @@ TEST_P(DrillScenario, MissesExactlyTheTargetsItsScriptBreaks) {
   }
 }
 
+// The difficulty changes the outcome of the same hands (data/drills/capsulorhexis.json "hard":
+// an 88-year-old's capsule, anterior bowing 0.4 kPa, a 2.2 mm chamber). The expert's tracks, which
+// meet every target on the standard eye (centring 0.04 mm, circularity 0.95, no warning), give a
+// run-out warning and a less round, less centred opening: the bowed membrane pulls the tear
+// outward (seed 004 §1).
+TEST(DrillDifficulty, TheExpertsHandsOnAHardEyeGetARunoutWarning) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "whole drills take minutes under ASan; the Release pass runs them";
+#endif
+  Scenario s = test::repo_scenario("capsulorhexis_expert.json");
+  s.difficulty = "hard";
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  const RunReport hard = run_scenario(s, o);
+  EXPECT_GE(hard.metrics.value("runout_warnings", 0.0), 1.0);
+  EXPECT_EQ(hard.metrics.value("rhexis.complete", 0.0), 1.0) << "still a complete opening";
+  EXPECT_GT(hard.metrics.value("rhexis.centering_mm", 0.0), 0.2);
+  EXPECT_LT(hard.metrics.value("rhexis.circularity", 1.0), 0.93);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Drills, DrillScenario,
     ::testing::Values(
         DrillCase{"capsulorhexis_expert.json", {}, {"grasp", "release"}},
-        DrillCase{"capsulorhexis_novice_off_centre.json", {"rhexis.centering_mm"}, {}},
+        DrillCase{"capsulorhexis_novice_off_centre.json",
+                  {"rhexis.centering_mm", "rhexis.puncture_offset_mm"},
+                  {}},
         DrillCase{"capsulorhexis_novice_small.json", {"rhexis.diameter_mm"}, {}},
         DrillCase{"capsulorhexis_novice_runout.json",
                   {"rhexis.radial_tearouts", "rhexis.diameter_mm", "rhexis.circularity"},
@@ -78,7 +100,14 @@ INSTANTIATE_TEST_SUITE_P(
         DrillCase{"phaco_sculpting_novice_narrow.json",
                   {"trench.width_mm", "trench.0.width_mm", "trench.1.width_mm",
                    "trench.crossing_angle_deg"},
-                  {}}),
+                  {}},
+        // The incision: a straight keratome pass; the steep one keeps the site and the width but
+        // its tunnel is under 1 mm (scripts/scenarios/incision.py).
+        DrillCase{"corneal_incision_expert.json", {}, {}},
+        DrillCase{"corneal_incision_novice_steep.json",
+                  {"incision.entry_angle_deg", "incision.tunnel_length_mm"},
+                  {}},
+        DrillCase{"corneal_incision_novice_site.json", {"incision.limbus_distance_mm"}, {}}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));

@@ -19,6 +19,10 @@ std::filesystem::path cache_dir() {
 }
 
 Scenario small_scenario(Drill drill = Drill::Capsulorhexis) {
+  // The right hand holds a tool the drill allows (data/drills).
+  const std::string right = drill == Drill::CornealIncision ? "keratome"
+                            : drill == Drill::PhacoSculpting ? "phaco_probe"
+                                                             : "cystotome";
   const std::string text = R"({
     "drill": ")" + std::string(to_string(drill)) + R"(",
     "eye": { "level": 0 },
@@ -27,7 +31,7 @@ Scenario small_scenario(Drill drill = Drill::Capsulorhexis) {
       "left":  { "tool": "forceps", "track": [
         { "t": 0.0, "pos": [-1.0, 0.0, 3.5], "quat": [1, 0, 0, 0], "grip": 0.0 },
         { "t": 0.5, "pos": [-1.0, 0.5, 2.0], "quat": [0.7071, 0.7071, 0, 0], "grip": 1.0 } ] },
-      "right": { "tool": "cystotome", "track": [
+      "right": { "tool": ")" + right + R"(", "track": [
         { "t": 0.0, "pos": [0.0, 0.0, 3.5], "quat": [1, 0, 0, 0] },
         { "t": 0.25, "pos": [0.0, 0.0, 1.9], "quat": [1, 0, 0, 0] } ] }
     } })";
