@@ -7,6 +7,8 @@
 //                           speed versus accuracy, stability map
 //   phaco-perf cut          issue 4: cut and tear step cost per capsule level, cut fidelity
 //                           (Hausdorff, remeshing), scripted capsulorhexis opening per level
+//   phaco-perf haptics      issue 6: the 1 kHz haptic thread beside the scene, the local model
+//   phaco-perf drills       issue 7: expert and novice drills, difficulty levels, comparisons
 //   phaco-perf all          every study above, in that order
 //
 // Every study takes --quick (small levels, few steps, about a minute) and --out-dir DIR (default
@@ -63,8 +65,14 @@ studies:
       the loop alone with a busy second core; the local model's passive stiffness against the rate
       (Colgate's bound), continuity with and without the crossfade, tick cost per node count; the UDP
       bridge's round trip and silence-to-zero-force. About 4 minutes (quick about 30 s).
+  drills
+      Issue 7, the drills: every scripted expert and novice (data/scenarios) run to its end: score,
+      missed targets, key metrics, globe rotation and port force, per-frame cost of the drill's
+      systems; the capsulorhexis and sculpting experts at every difficulty level of their drill
+      files; every novice against its drill's expert by dynamic time warping. About 2 minutes
+      (quick: one expert and one novice per drill, one level).
   all
-      foundation, bandwidth, membrane, cut, lens, haptics.
+      foundation, bandwidth, membrane, cut, lens, haptics, drills.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -105,6 +113,8 @@ int main(int argc, char** argv) {
       perf::run_lens(options);
     } else if (cmd == "haptics") {
       perf::run_haptics(options);
+    } else if (cmd == "drills") {
+      perf::run_drills(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");
@@ -114,6 +124,7 @@ int main(int argc, char** argv) {
       perf::run_cut(options);
       perf::run_lens(options);
       perf::run_haptics(options);
+      perf::run_drills(options);
     } else {
       std::fprintf(stderr, "phaco-perf: unknown study '%s' (try --help)\n", cmd.c_str());
       return 2;

@@ -16,6 +16,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev       # Google Benchmark
   libglfw3-dev libepoxy-dev libimgui-dev   # trainer (later issues)
+  xvfb mesa-utils libgl1-mesa-dri   # renderer tests: a virtual X display, Mesa's llvmpipe
   chromium               # headless check of the HTML report
 )
 

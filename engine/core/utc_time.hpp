@@ -1,15 +1,13 @@
 #pragma once
-// The calendar time of records and reports, in UTC.
-#include <ctime>
+// Calendar time, UTC, in the one format the records and run reports store:
+// "2026-11-21T19:30:00.123Z" (ISO 8601 with milliseconds; sorts as text in time order).
 #include <string>
 
 namespace phaco {
 
-// `t` as "2026-11-21T19:30:00Z" (ISO 8601, what the records and run reports store).
-std::string utc_iso8601(std::time_t t);
-// Now, as above.
-inline std::string utc_now() {
-  return utc_iso8601(std::time(nullptr));
-}
+// `unix_seconds` since the Unix epoch, rounded to the millisecond.
+std::string format_utc(double unix_seconds);
+// Now.
+std::string utc_now();
 
 }  // namespace phaco

@@ -24,6 +24,8 @@ using io::path_key;
 
 constexpr std::array<std::string_view, 6> kBodies{"cornea", "capsule",      "iris",
                                                   "globe",  "lens_surface", "lens"};
+// The corneal ports' modes (procedures/scene/tool_ports.hpp).
+constexpr std::array<std::string_view, 3> kPortsModes{"off", "measure", "constrain"};
 constexpr double kTotalPoints = 100.0;
 constexpr double kPointsTolerance = 1e-6;
 
@@ -37,7 +39,7 @@ class DrillParser {
     }
     r_.expect_object(root, "$",
                      {"drill", "title", "description", "scene", "tools", "targets", "scoring",
-                      "guidance", "difficulty"});
+                      "guidance", "difficulty", "ports"});
     DrillFile d;
     d.source = r_.source();
     const json& drill = r_.require(root, "$", "drill", "a drill name");
@@ -58,6 +60,19 @@ class DrillParser {
             d);
     if (const json* v = JsonReader::find(root, "guidance")) d.guidance = guidance(*v);
     difficulty(r_.require(root, "$", "difficulty", "{\"default\", \"levels\"}"), d);
+    if (const json* v = JsonReader::find(root, "ports")) {
+      d.ports = r_.string(*v, "ports");
+      if (std::find(kPortsModes.begin(), kPortsModes.end(), d.ports) == kPortsModes.end()) {
+        r_.fail("ports",
+                "unknown mode '" + d.ports + "'; expected one of: " + io::join_names(kPortsModes));
+      }
+      // The ports sit at the guidance's incision site and side port (procedures/scene/tool_ports).
+      if (d.ports != "off" && (!d.guidance.incision_site || !d.guidance.side_port)) {
+        r_.fail("ports", "mode '" + d.ports +
+                             "' needs guidance.incision_site and guidance.side_port, where the "
+                             "ports are");
+      }
+    }
     return d;
   }
 

@@ -75,6 +75,9 @@ struct DrillFile {
   Guidance guidance;
   std::map<std::string, DifficultySettings> difficulty;  // level name → settings
   std::string default_difficulty;                        // a key of `difficulty`
+  // The corneal ports' mode when the scenario's methods["tools.ports"] does not say
+  // (procedures/scene/tool_ports, docs/tool_eye_interaction.md): "off", "measure", "constrain".
+  std::string ports = "off";
 };
 
 // Body names a drill's scene may list, in the scene's creation order.

@@ -312,26 +312,5 @@ std::string RecordStore::integrity_check() const {
   return s.step("cannot check integrity") ? s.text(0) : std::string("no answer");
 }
 
-std::string format_utc(double unix_seconds) {
-  double whole = std::floor(unix_seconds);
-  int ms = static_cast<int>(std::lround((unix_seconds - whole) * 1000.0));
-  if (ms >= 1000) {
-    ms -= 1000;
-    whole += 1;
-  }
-  const std::time_t t = static_cast<std::time_t>(whole);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[96];  // sized for any int fields, which gmtime never gives, to keep -Wformat quiet
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
-                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ms);
-  return buf;
-}
-
-std::string utc_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return format_utc(static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9);
-}
 
 }  // namespace phaco

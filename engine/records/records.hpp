@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/core/utc_time.hpp"
+
 struct sqlite3;
 
 namespace phaco {
@@ -78,10 +80,7 @@ class RecordStore {
   sqlite3* db_ = nullptr;
 };
 
-// Now, UTC, in the record's time format.
-std::string utc_now();
-// `t` seconds since the Unix epoch in the record's time format.
-std::string format_utc(double unix_seconds);
+// The record's time format: engine/core/utc_time.hpp (utc_now, format_utc).
 
 // The unit of a metric named with its unit in the name (issue 7: "left.tool_speed_mm_s.mean" ->
 // "mm/s", "incision.entry_angle_deg" -> "deg", "score" -> "points", "regrasps" -> "1").

@@ -52,15 +52,28 @@ RealtimeRunReport run_realtime(const Scenario& scenario, SceneOptions options,
 
   RealtimeRunReport report;
   std::vector<double> costs;
-  costs.reserve(frames_total);
+  costs.reserve(std::min<uint64_t>(frames_total, uint64_t{1} << 20));
   // The first model before the thread starts, so the first tick already has the scene.
   step(*scene);
+  if (run.after_frame) run.after_frame(*scene);
   session.start();
   const int64_t start = now_ns();
+  int64_t paused_ns = 0;  // wall time spent paused: the frame clock is shifted by it
   const auto dt_ns = static_cast<int64_t>(std::llround(dt * 1e9));
   bool stalled = false;
   for (uint64_t k = 0; k < frames_total; ++k) {
-    const int64_t deadline = start + static_cast<int64_t>(k) * dt_ns;
+    if (run.stop && run.stop->load(std::memory_order_acquire)) break;
+    if (run.pause && run.pause->load(std::memory_order_acquire)) {
+      const int64_t paused_at = now_ns();
+      while (run.pause->load(std::memory_order_acquire) &&
+             !(run.stop && run.stop->load(std::memory_order_acquire))) {
+        sleep_until_ns(now_ns() + 2'000'000);  // a UI's pause: 2 ms polling is plenty
+      }
+      paused_ns += now_ns() - paused_at;
+      --k;  // the frame was not stepped: check stop, then step it
+      continue;
+    }
+    const int64_t deadline = start + paused_ns + static_cast<int64_t>(k) * dt_ns;
     int64_t now = now_ns();
     if (now < deadline) {
       sleep_until_ns(deadline);
@@ -82,8 +95,9 @@ RealtimeRunReport run_realtime(const Scenario& scenario, SceneOptions options,
     step(*scene);
     costs.push_back(cost.elapsed_ms());
     ++report.frames;
+    if (run.after_frame) run.after_frame(*scene);
   }
-  report.wall_s = static_cast<double>(now_ns() - start) * 1e-9;
+  report.wall_s = static_cast<double>(now_ns() - start - paused_ns) * 1e-9;
   const HapticSessionStats running = session.stats();  // the devices' health while they ran
   session.stop();
   report.haptics = session.stats();
@@ -91,6 +105,7 @@ RealtimeRunReport run_realtime(const Scenario& scenario, SceneOptions options,
   report.frame_max_ms = costs.empty() ? 0 : *std::max_element(costs.begin(), costs.end());
   report.frame_p99_ms = percentile(costs, 0.99);
   report.frame_p50_ms = percentile(costs, 0.50);
+  if (run.at_end) run.at_end(*scene);
   return report;
 }
 

@@ -6,7 +6,9 @@
 //
 // A stall can be injected (the simulation thread sleeps `stall_ms` at `stall_at_s` instead of
 // stepping) to show that the haptic thread keeps the force continuous without new models.
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "procedures/haptics/haptic_session.hpp"
@@ -21,6 +23,13 @@ struct RealtimeRunOptions {
   // The scene is rebuilt and restarted when its scenario ends before duration_s (the harness
   // runs a 60 s measurement on a 40 s scenario).
   bool loop_scenario = true;
+  // The trainer's hooks (procedures/trainer), all on the simulation thread; empty/null: unused.
+  std::function<void(Scene&)> after_frame;  // after every step (and the one before the start)
+  std::function<void(Scene&)> at_end;       // once, after the last frame, the session stopped
+  const std::atomic<bool>* stop = nullptr;  // set: the run ends before its next frame
+  // Set: no steps (the haptic thread runs on); on resume the frame clock restarts from now, so
+  // the paused time is neither simulated nor caught up.
+  const std::atomic<bool>* pause = nullptr;
 };
 
 struct RealtimeRunReport {

@@ -454,6 +454,18 @@ SystemDesc drill_metrics_system(Scene& scene) {
       }};
 }
 
+size_t drill_event_count(Scene& scene) {
+  const DrillRecord* r = record_of(scene);
+  return r ? r->events.size() : 0;
+}
+
+LiveDrillEvent drill_event(Scene& scene, size_t index) {
+  const DrillRecord& r = *record_of(scene);
+  const DrillEvent& e = r.events.at(index);
+  const int hand = e.hand < 0 ? -1 : static_cast<int>(r.hands[static_cast<size_t>(e.hand)].hand);
+  return {e.t_s, e.kind, hand, e.detail, e.value};
+}
+
 DrillReport drill_report(Scene& scene) {
   DrillReport out;
   const DrillRecord* r = record_of(scene);

@@ -24,6 +24,7 @@
 // Reads: tools.pose, tools.grasp, capsule.particles, capsule.physics, lens.tets. Writes: metrics
 // (its own record, kept on the scene's first body: the scene has no drill entity). Per frame it
 // appends to vectors reserved for the scenario's frame count (no allocation in a normal run).
+#include <cstddef>
 #include <nlohmann/json.hpp>
 
 #include "engine/schedule/system.hpp"
@@ -53,5 +54,19 @@ DrillReport drill_report(Scene& scene);
 // opening that never closed) scores 0.
 double band_points(const nlohmann::json& value, const nlohmann::json& target, double falloff,
                    double weight);
+
+// The trainer's live warnings (procedures/trainer): the events recorded so far, in time order,
+// read on the simulation thread between frames. `kind` and `detail` are string literals (static
+// storage), so an event may be handed to another thread as is. hand: the Hand's index, −1 for the
+// drill's own events.
+struct LiveDrillEvent {
+  double t_s = 0;
+  const char* kind = "";
+  int hand = -1;
+  const char* detail = nullptr;  // name of `value`, if any
+  double value = 0;
+};
+size_t drill_event_count(Scene& scene);
+LiveDrillEvent drill_event(Scene& scene, size_t index);  // index < drill_event_count
 
 }  // namespace phaco

@@ -92,7 +92,8 @@ bool is_ports_method(const std::string& key) {
 
 std::string ports_mode(const Scene& scene) {
   const auto it = scene.scenario.methods.find("tools.ports");
-  if (it == scene.scenario.methods.end()) return "off";
+  // The drill file's "ports" (validated by engine/io/drill_file) when the scenario does not say.
+  if (it == scene.scenario.methods.end()) return scene.drill.ports;
   if (it->second == "off" || it->second == "measure" || it->second == "constrain")
     return it->second;
   throw InputError(scene.scenario.source + ": methods[\"tools.ports\"]: unknown choice '" +
@@ -106,7 +107,7 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
   // Where the ports are is the drill's (guidance.incision_site and side_port, data/drills).
   const Guidance& g = scene.drill.guidance;
   if (!g.incision_site || !g.side_port) {
-    throw InputError(scene.scenario.source + ": methods[\"tools.ports\"]: the drill file " +
+    throw InputError(scene.scenario.source + ": tools.ports " + mode + ": the drill file " +
                      scene.drill.source +
                      " names no guidance.incision_site and side_port for the ports");
   }
@@ -144,10 +145,17 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
           tool_eye::HandPose& h = hands[i];
           h.tip_mm = pose.pos;
           h.shaft = pose.quat.normalized() * Vec3::UnitZ();
+          const ToolKind kind = scene.world.at<Tool>(scene.tools[i]).kind;
           // The phaco probe's work is inside the nucleus: the lens is no boundary for it.
-          h.lens_spring = scene.world.at<Tool>(scene.tools[i]).kind != ToolKind::PhacoProbe;
-          h.port = tool_eye::engaged_port(rec->ports, globe.rotation, rec->eye.globe_centre_mm,
-                                          h.tip_mm, h.shaft, globe.tools[i].port);
+          h.lens_spring = kind != ToolKind::PhacoProbe;
+          // The keratome cuts its tunnel (cornea_cutting), it does not pass through one: the
+          // ports model finished incisions, and a blade pressed through the slit "across" would
+          // be read as a tunnel pushed on (82 mN for the incision expert) when it is the cut.
+          h.port =
+              kind == ToolKind::Keratome
+                  ? -1
+                  : tool_eye::engaged_port(rec->ports, globe.rotation, rec->eye.globe_centre_mm,
+                                           h.tip_mm, h.shaft, globe.tools[i].port);
         }
         tool_eye::solve(rec->ports, rec->eye, rec->stiffness,
                         std::span<const tool_eye::HandPose>(hands.data(), n), globe);

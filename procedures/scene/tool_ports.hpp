@@ -2,8 +2,9 @@
 // The scene's corneal ports and the tool–eye equilibrium each frame (seed 001 §3.2, seed 002 §7;
 // systems/tool_eye does the minimisation, docs/tool_eye_interaction.md).
 //
-// Mode, scenario `methods["tools.ports"]`:
-//   "off"       (default) no ports, no system: scenes and their state hashes as before;
+// Mode, scenario `methods["tools.ports"]`, else the drill file's "ports" (every shipped drill:
+// "measure"; a drill file without the field: "off"):
+//   "off"       no ports, no system: scenes and their state hashes as before;
 //   "measure"   each frame, after move_tools, find which port each tool is in and solve the
 //               equilibrium; record the globe's rotation and the port forces; ToolState untouched;
 //   "constrain" the same, and write the shown (equilibrium) pose into ToolState, so the rest of
@@ -57,7 +58,8 @@ struct PortsRecord {
 
 bool is_ports_method(const std::string& key);  // "tools.ports"
 
-// "off", "measure" or "constrain"; InputError naming the scenario and key otherwise.
+// The scenario's methods["tools.ports"] if given, else the drill file's "ports": "off",
+// "measure" or "constrain"; InputError naming the scenario and key otherwise.
 std::string ports_mode(const Scene& scene);
 
 // Adds the ports and their record and returns the Input-phase system (after move_tools); nullopt

@@ -9,8 +9,12 @@ usage: capsulorhexis.py OUT.json [--scale F] [--shift DX,DY] [--outward T0,T1,G]
 --outward pulls the forceps outward between T0 and T1 s, the radius growing to (1 + G) times
           (a tear that runs out radially).
 Every point near the capsule keeps its height above the anterior lens surface (DESIGN.md §6).
+Then each hand pivots in its corneal port (scripts/scenarios/ports.py): the forceps' (left hand)
+shaft passes through the side port's centre, the cystotome's (right hand) through the main
+port's, whenever the tip is inside the eye; the tips' paths are the ones above.
 """
 import argparse, json, math, os, re
+import ports
 
 A, R = 1.8, 4.7  # anterior half-thickness and equatorial radius of the standard lens, mm
 
@@ -46,6 +50,11 @@ if args.outward:
     for p in s["hands"]["left"]["track"]:
         if t0 <= p["t"] <= t1:
             move(p, 1 + g * (p["t"] - t0) / (t1 - t0))
+port_of = {"left": "side", "right": "main"}
+centres = ports.default_ports(s["drill"])
+for name, hand in s["hands"].items():
+    centre, axis = centres[port_of[name]]
+    hand["track"] = ports.pivot_track(hand["track"], centre, axis, ports.inside_eye())
 s["name"], s["description"] = args.name, args.description
 text = json.dumps(s, indent=2)
 # one sample per line, as the other scenarios

@@ -9,6 +9,8 @@ tilted `angle` degrees below the surface's tangent plane (the angle that sets th
 about limbal thickness / sin angle). It advances straight along its axis until its shoulders are
 2.1 mm past the posterior surface (full width on both surfaces), pauses, and withdraws along the
 same line. Deterministic; the eye is data/eye/standard_eye.json's (DESIGN.md §6 frame, mm).
+The keratome does not pivot in a port (scripts/scenarios/ports.py): it is cutting the main port,
+and the tool-eye ports leave it out (docs/tool_eye_interaction.md).
 """
 import argparse, json, math
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates the expert and novice drill scenarios (issue 7) in data/scenarios from the demos.
+# Every tool but the keratome pivots in its corneal port (ports.py; docs/tool_eye_interaction.md).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 out="$here/../../data/scenarios"

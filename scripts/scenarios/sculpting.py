@@ -6,9 +6,12 @@ usage: sculpting.py OUT.json [--passes 0.8,1.5,2.2,2.65] [--lanes -0.35,0.35] [-
 The phaco probe enters through the temporal incision, sculpts a trench in passes of increasing
 depth (mm below the anterior lens surface at the centre), one pass per lane, turns the nucleus a
 quarter turn with the tip in the trench (pedal 1) and sculpts the second trench the same way.
-The defaults are data/scenarios/phaco_sculpting_demo.json (the expert).
+The defaults are data/scenarios/phaco_sculpting_demo.json (the expert). The probe pivots in the
+main corneal port (scripts/scenarios/ports.py): its shaft passes through the port's centre in
+every sample, and it rests 0.25 mm inside that centre on the tunnel's axis.
 """
 import argparse, json, math
+import ports
 ap = argparse.ArgumentParser()
 ap.add_argument("out")
 ap.add_argument("--passes", default="0.8,1.5,2.2,2.65")
@@ -17,7 +20,8 @@ ap.add_argument("--name", default="phaco sculpting demo")
 ap.add_argument("--description", default="Divide and conquer: the phaco probe through the temporal incision sculpts a trench in four passes of increasing depth, two lanes each (pedal 3), rotates the nucleus a quarter turn with the tip in the trench (pedal 1), and sculpts the second trench the same way.")
 args = ap.parse_args()
 A, C = 4.7, 1.8          # lens equatorial radius, anterior half-thickness
-port = (5.6, 0.0, 2.6)    # temporal incision (3 o'clock side), where the shaft leaves the eye
+port, axis = ports.default_ports("phaco_sculpting")["main"]  # temporal incision, 3 o'clock
+rest = [round(port[i] + 0.25 * axis[i], 4) for i in range(3)]  # in the tunnel, on its axis
 def lens_top(x, y):
     s = 1 - (x*x + y*y) / (A*A)
     return C * math.sqrt(max(s, 0))
@@ -38,7 +42,7 @@ def add(dt, pos, pedal):
     t += dt
     pos = [round(v, 4) for v in pos]
     track.append({"t": round(t, 3), "pos": pos, "quat": quat_for(pos), "pedal": pedal})
-track.append({"t": 0.0, "pos": [5.3, 0, 2.5], "quat": quat_for((5.3, 0, 2.5)), "pedal": 0})
+track.append({"t": 0.0, "pos": rest, "quat": quat_for(rest), "pedal": 0})
 def trench_pass(depth, y):
     # above the near end, down with irrigation, sculpt away from the incision, lift, come back
     x0, x1 = 2.3, -2.3
@@ -68,7 +72,10 @@ for k in range(1, n + 1):
     add(2.0 / n, (r * math.cos(a), r * math.sin(a), z), 1)
 add(0.4, (r * math.cos(a), r * math.sin(a), 2.3), 1)
 trench()
-add(0.8, (5.3, 0, 2.5), 0)
+add(0.8, rest, 0)
+# Between the samples the engine interpolates (lerp, slerp): extra samples keep the shaft on the
+# port's centre there too.
+track = ports.pivot_track(track, port, axis, ports.inside_eye())
 sc = {
   "name": args.name,
   "description": args.description,

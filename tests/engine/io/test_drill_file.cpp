@@ -140,6 +140,38 @@ TEST(DrillFile, MalformedFilesNameTheField) {
             std::string::npos);
 }
 
+// "ports": the corneal ports' mode when a scenario does not choose (procedures/scene/tool_ports):
+// absent is "off"; the shipped drills measure; anything but off/measure/constrain is refused.
+TEST(DrillFile, PortsModeIsOptionalAndChecked) {
+  EXPECT_EQ(parse(valid_drill()).ports, "off");
+  for (const char* mode : {"off", "measure", "constrain"}) {
+    json j = valid_drill();
+    j["guidance"]["incision_site"] = {{"clock_hour", 3}, {"limbus_distance_mm", 0.3}};
+    j["guidance"]["side_port"] = {{"clock_hour", 11}, {"limbus_distance_mm", 0.3}};
+    j["ports"] = mode;
+    EXPECT_EQ(parse(j).ports, mode);
+  }
+  json unplaced = valid_drill();  // no incision site or side port: nowhere to put the ports
+  unplaced["ports"] = "measure";
+  const std::string e0 = input_error_of([&] { parse(unplaced); });
+  EXPECT_NE(e0.find("d.json: ports: mode 'measure' needs guidance.incision_site"),
+            std::string::npos)
+      << e0;
+  for (const char* name : {"corneal_incision", "capsulorhexis", "phaco_sculpting"}) {
+    EXPECT_EQ(load_drill_file(kDrillDir / (std::string(name) + ".json")).ports, "measure") << name;
+  }
+  json bad = valid_drill();
+  bad["ports"] = "sometimes";
+  const std::string e = input_error_of([&] { parse(bad); });
+  EXPECT_NE(e.find("d.json: ports: unknown mode 'sometimes'; expected one of: off, measure, "
+                   "constrain"),
+            std::string::npos)
+      << e;
+  bad["ports"] = true;
+  const std::string e2 = input_error_of([&] { parse(bad); });
+  EXPECT_NE(e2.find("d.json: ports: expected a string"), std::string::npos) << e2;
+}
+
 TEST(DrillFile, DifficultyIsTheLevelWithTheScenarioSettingsOverIt) {
   const DrillFile d = parse(valid_drill());
   EXPECT_EQ(resolve_difficulty(d, "", {}, "s.json"), DifficultySettings{});

@@ -3,13 +3,21 @@
 // novice misses exactly the targets its script breaks — including the ones that follow from it
 // physically (a radial run-out also enlarges and distorts the opening; a shallow or narrow trench
 // gives the probe less purchase, so the quarter turn falls short and the trenches cross at ~72°)
-// — and shows the expected events.
+// — and shows the expected events. The drills measure the corneal ports by default (their files'
+// "ports"), so the targets include globe.max_rotation_deg and ports.max_force_mN: the scripted
+// hands pivot in their ports, and no novice's defect is a port's (none misses a port target).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 
+#include "engine/io/track.hpp"
+#include "procedures/eye/eye_geometry.hpp"
 #include "procedures/scene/run.hpp"
+#include "procedures/scene/scene.hpp"
+#include "procedures/scene/tool_ports.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
@@ -79,6 +87,46 @@ TEST(DrillDifficulty, TheExpertsHandsOnAHardEyeGetARunoutWarning) {
   EXPECT_EQ(hard.metrics.value("rhexis.complete", 0.0), 1.0) << "still a complete opening";
   EXPECT_GT(hard.metrics.value("rhexis.centering_mm", 0.0), 0.2);
   EXPECT_LT(hard.metrics.value("rhexis.circularity", 1.0), 0.93);
+}
+
+// The scripted hands pivot in their corneal ports (scripts/scenarios/ports.py computes the port
+// centres in Python): at every frame with the tip inside the eye, the shaft's line passes the C++
+// default_ports centre — main for the right hand, side for the left — within 0.02 mm. This keeps
+// the generator's copy of default_ports honest. The keratome cuts its port and is not checked.
+TEST(DrillPivot, TheScriptedShaftsPassThroughTheirPortCentres) {
+  const eye::EyeParams params = eye::default_eye_params();
+  const eye::EyeGeometry g = eye::eye_geometry(params);
+  for (const char* file : {"capsulorhexis_expert.json", "capsulorhexis_novice_off_centre.json",
+                           "capsulorhexis_novice_runout.json", "capsulorhexis_novice_small.json",
+                           "phaco_sculpting_expert.json", "phaco_sculpting_novice_shallow.json",
+                           "phaco_sculpting_novice_narrow.json"}) {
+    const Scenario s = test::repo_scenario(file);
+    const DrillFile drill = load_drill_for(s);
+    ASSERT_TRUE(drill.guidance.incision_site && drill.guidance.side_port) << file;
+    const auto ports = default_ports(params, drill.guidance.incision_site->clock_hour,
+                                     drill.guidance.side_port->clock_hour);
+    for (const HandTrack& h : s.hands) {
+      const Vec3 centre = ports[h.hand == Hand::Right ? 0 : 1].centre_mm;
+      double worst = 0;
+      int inside = 0;
+      for (uint64_t f = 0; f <= s.frame_count(); ++f) {
+        const ToolPose p = sample_track(h.track, static_cast<double>(f) * s.dt_s);
+        const double rho = std::hypot(p.pos.x(), p.pos.y());
+        const double front =
+            rho < g.limbus_radius
+                ? g.cornea_anterior_centre_z +
+                      std::sqrt(g.cornea_anterior_radius * g.cornea_anterior_radius - rho * rho)
+                : -1e9;
+        if (p.pos.z() >= front) continue;  // outside the eye: the hand is free
+        ++inside;
+        const Vec3 shaft = p.quat.normalized() * Vec3::UnitZ();
+        const Vec3 d = centre - p.pos;
+        worst = std::max(worst, (d - d.dot(shaft) * shaft).norm());
+      }
+      EXPECT_GT(inside, 0) << file;
+      EXPECT_LT(worst, 0.02) << file << ": shaft passes the port centre " << worst << " mm off";
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(

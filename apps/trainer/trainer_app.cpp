@@ -1,0 +1,258 @@
+#include "apps/trainer/trainer_app.hpp"
+
+// GLFW must not pull in a GL header: libepoxy provides the GL declarations.
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "apps/trainer/trainer_ui.hpp"
+#include "engine/core/clock.hpp"
+#include "engine/core/error.hpp"
+#include "engine/render/offscreen.hpp"
+#include "engine/render/renderer.hpp"
+#include "procedures/trainer/trainer_session.hpp"
+
+namespace phaco::trainer {
+
+namespace {
+
+// Frame times of the render loop, for --stats (kept on the main thread; the loop's own figure).
+struct FrameClock {
+  std::vector<double> ms;
+  int64_t start_ns = now_ns(), last_ns = now_ns();
+  void tick() {
+    const int64_t t = now_ns();
+    ms.push_back(static_cast<double>(t - last_ns) * 1e-6);
+    last_ns = t;
+  }
+  double percentile(double p) const {
+    if (ms.empty()) return 0;
+    std::vector<double> s = ms;
+    std::sort(s.begin(), s.end());
+    return s[std::min(s.size() - 1, static_cast<size_t>(p * static_cast<double>(s.size())))];
+  }
+};
+
+struct Glfw {
+  Glfw() {
+    glfwSetErrorCallback([](int code, const char* text) {
+      std::fprintf(stderr, "phaco-trainer: GLFW error %d: %s\n", code, text);
+    });
+    if (!glfwInit()) {
+      throw render::RenderError(
+          "cannot open a display (is DISPLAY set? on a machine without one, run under xvfb-run, "
+          "or use the headless demo: phaco run data/scenarios/capsulorhexis_expert.json)");
+    }
+  }
+  ~Glfw() { glfwTerminate(); }
+};
+
+// Mouse, wheel, keys and gamepad → the session's DesktopInput (the main thread is its one writer).
+struct InputGlue {
+  double last_x = 0, last_y = 0;
+  bool have_last = false;
+  double wheel = 0;  // accumulated by the scroll callback
+  bool tab_down = false, space_down = false, r_down = false, g_down = false;
+};
+
+InputGlue* glue_of(GLFWwindow* w) {
+  return static_cast<InputGlue*>(glfwGetWindowUserPointer(w));
+}
+
+bool pressed_once(GLFWwindow* w, int key, bool& was_down) {
+  const bool down = glfwGetKey(w, key) == GLFW_PRESS;
+  const bool edge = down && !was_down;
+  was_down = down;
+  return edge;
+}
+
+TrainerConfig config_of(const TrainerOptions& o) {
+  TrainerConfig c;
+  c.scenario = load_scenario(o.scenario);
+  if (!o.difficulty.empty()) c.scenario.difficulty = o.difficulty;
+  c.devices = {o.left, o.right};
+  c.scene.threads = o.threads;
+  c.scene.cache_dir = o.cache_dir;
+  c.trainee = o.trainee;
+  c.records_db = o.db;
+  return c;
+}
+
+void write_stats(const std::filesystem::path& file, const TrainerOptions& o, const FrameClock& fc,
+                 const TrainerStatus& s, double wall_s) {
+  nlohmann::json j;
+  j["width"] = o.width;
+  j["height"] = o.height;
+  j["render"] = o.render;
+  j["renderer"] = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  j["frames"] = fc.ms.size();
+  j["wall_s"] = wall_s;
+  j["fps"] = wall_s > 0 ? static_cast<double>(fc.ms.size()) / wall_s : 0.0;
+  j["frame_p50_ms"] = fc.percentile(0.5);
+  j["frame_p99_ms"] = fc.percentile(0.99);
+  j["sim_time_s"] = s.sim_time_s;
+  j["sim_frames"] = s.frame;
+  j["sim_rate_hz"] = wall_s > 0 ? static_cast<double>(s.frame) / wall_s : 0.0;
+  j["haptic_period_p50_us"] = s.haptic_period_p50_us;
+  j["haptic_period_p99_us"] = s.haptic_period_p99_us;
+  j["haptic_ticks"] = s.haptic_ticks;
+  j["snapshots_published"] = s.snapshots_published;
+  std::ofstream out(file);
+  out << j.dump(2) << "\n";
+  if (!out) throw InputError(file.string() + ": cannot write the statistics");
+}
+
+}  // namespace
+
+int run_trainer(const TrainerOptions& o) {
+  TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
+  Glfw glfw;
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  GLFWwindow* window = glfwCreateWindow(o.width, o.height, "OpenPhaco trainer", nullptr, nullptr);
+  if (!window) throw render::RenderError("cannot create an OpenGL 3.3 core window");
+  glfwMakeContextCurrent(window);
+  // Unattended runs measure and capture as fast as the renderer goes; a trainee gets v-sync.
+  glfwSwapInterval(o.screenshot || o.stats ? 0 : 1);
+  InputGlue glue;
+  glfwSetWindowUserPointer(window, &glue);
+  glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) { glue_of(w)->wheel += dy; });
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330");
+
+  int exit_code = 0;
+  {
+    render::RenderOptions ro;
+    ro.stereo = o.stereo ? render::StereoMode::SideBySide : render::StereoMode::Mono;
+    ro.guidance = o.guidance;
+    render::Renderer renderer(ro);
+    render::Microscope microscope;
+    auto session = std::make_unique<TrainerSession>(config);
+    session->start();
+    TrainerUi ui(o, config);
+    FrameClock frames;
+    const int64_t t0 = now_ns();
+    const auto wall_s = [&] { return static_cast<double>(now_ns() - t0) * 1e-9; };
+
+    while (!glfwWindowShouldClose(window)) {
+      glfwPollEvents();
+      if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
+      const bool ui_has_mouse = o.ui && ImGui::GetIO().WantCaptureMouse;
+      const bool ui_has_keys = o.ui && ImGui::GetIO().WantCaptureKeyboard;
+
+      // Input → DesktopInput (read by the haptic thread through the hands' devices).
+      DesktopInput& in = session->desktop();
+      double x = 0, y = 0;
+      glfwGetCursorPos(window, &x, &y);
+      if (glue.have_last && !ui_has_mouse) in.mouse_move(x - glue.last_x, y - glue.last_y);
+      glue.last_x = x, glue.last_y = y, glue.have_last = true;
+      if (glue.wheel != 0 && !ui_has_mouse) in.wheel(glue.wheel);
+      glue.wheel = 0;
+      if (!ui_has_mouse) {
+        in.mouse_buttons(glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS,
+                         glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS);
+      }
+      if (glfwJoystickIsGamepad(GLFW_JOYSTICK_1)) {
+        GLFWgamepadstate g;
+        if (glfwGetGamepadState(GLFW_JOYSTICK_1, &g)) {
+          GamepadState pad;
+          for (int i = 0; i < 6; ++i) pad.axes[static_cast<size_t>(i)] = g.axes[i];
+          for (int i = 0; i < 15; ++i)
+            pad.buttons[static_cast<size_t>(i)] = g.buttons[i] == GLFW_PRESS;
+          in.gamepad(pad, frames.ms.empty() ? 0.0 : frames.ms.back() * 1e-3);
+        }
+      }
+      if (!ui_has_keys) {
+        if (pressed_once(window, GLFW_KEY_TAB, glue.tab_down)) in.switch_hand();
+        if (pressed_once(window, GLFW_KEY_SPACE, glue.space_down)) {
+          session->state() == TrainerState::Paused ? session->resume() : session->pause();
+        }
+        if (pressed_once(window, GLFW_KEY_R, glue.r_down)) session->reset();
+        if (pressed_once(window, GLFW_KEY_G, glue.g_down))
+          renderer.options().guidance = !renderer.options().guidance;
+      }
+
+      // The view: the newest snapshot the simulation published.
+      int fb_w = 0, fb_h = 0;
+      glfwGetFramebufferSize(window, &fb_w, &fb_h);
+      glViewport(0, 0, fb_w, fb_h);
+      glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      const render::RenderSnapshot* snap = session->newest_snapshot();
+      const TrainerStatus status = session->status();
+      if (!status.error.empty()) throw InputError("simulation stopped: " + status.error);
+
+      // After the simulated time, or at the drill's end if it is shorter.
+      if (o.screenshot && snap &&
+          (status.sim_time_s >= o.after_s || status.state == TrainerState::Ended)) {
+        // Off-screen at the window's size: a hidden or covered window's pixels are undefined.
+        render::OffscreenTarget target(o.width, o.height);
+        glViewport(0, 0, o.width, o.height);
+        glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        renderer.draw(*snap, microscope, o.width, o.height);
+        render::save_screenshot(*o.screenshot, o.width, o.height);
+        render::OffscreenTarget::unbind();
+        std::printf("screenshot at %.2f s simulated (%.1f s wall): %s\n", status.sim_time_s,
+                    wall_s(), o.screenshot->c_str());
+        break;
+      }
+      if (snap && o.render) renderer.draw(*snap, microscope, fb_w, fb_h);
+
+      if (o.ui) {
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back()) ==
+            UiAction::Restart) {
+          config = ui.config();
+          session = std::make_unique<TrainerSession>(config);
+          session->start();
+        }
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      }
+      glfwSwapBuffers(window);
+      frames.tick();
+
+      if (o.stats && wall_s() >= o.stats_after_s) {
+        write_stats(*o.stats, o, frames, session->status(), wall_s());
+        std::printf("statistics after %.1f s: %s\n", wall_s(), o.stats->c_str());
+        break;
+      }
+      if ((o.screenshot || o.stats) && wall_s() > o.timeout_s) {
+        std::fprintf(stderr,
+                     "phaco-trainer: timed out after %.0f s wall (simulated %.2f s of %.2f s)\n",
+                     wall_s(), status.sim_time_s, o.screenshot ? o.after_s : o.stats_after_s);
+        exit_code = 3;
+        break;
+      }
+    }
+    session->stop();
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window);
+  return exit_code;
+}
+
+}  // namespace phaco::trainer

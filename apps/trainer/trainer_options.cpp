@@ -1,0 +1,117 @@
+#include "apps/trainer/trainer_options.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "apps/phaco/args.hpp"
+#include "engine/core/error.hpp"
+#include "procedures/eye/eye_params.hpp"
+
+namespace phaco::trainer {
+
+const char* const kUsage = R"(phaco-trainer — OpenPhaco's cataract-surgery trainer (docs/trainer.md)
+
+usage:
+  phaco-trainer [--drill NAME | --scenario FILE] [--difficulty LEVEL] [--trainee NAME] [--db DB]
+                [--left DEVICE] [--right DEVICE] [--size WxH] [--stereo] [--no-guidance]
+                [--threads N] [--cache-dir DIR]
+  phaco-trainer ... --screenshot OUT.png [--after SECONDS] [--no-ui]
+  phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
+  phaco-trainer --help
+
+  --drill       corneal_incision | capsulorhexis | phaco_sculpting (default capsulorhexis); the
+                tools start where the drill's expert scenario starts them
+  --scenario    any scenario file instead (its tracks give the tools and start poses)
+  --difficulty  a level of the drill file (data/drills/<drill>.json: standard, easy, hard, ...)
+  --left/--right  the hand's device: desktop (mouse, keyboard, gamepad; default), scripted (the
+                scenario's track in real time through the 1 kHz loop), track (the scene plays the
+                track), replay:FILE, udp:LOCALPORT@HOST:PORT, openhaptics[:NAME]
+  --trainee     store each finished drill in the records database (phaco history NAME)
+  --screenshot  run unattended: save the view after --after simulated seconds (default 5), exit
+  --stats       run unattended: after --stats-after wall seconds (default 20) write the render
+                frame rate, the simulation rate and the haptic period as JSON, exit
+  --no-render   with --stats: keep the window and the loop but draw nothing (the baseline)
+
+controls: mouse moves the selected hand's tip, wheel = depth, left button = grip / ultrasound,
+right button = aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers =
+grip/pedal, bumpers = deeper); Space pauses; R restarts; G toggles the guidance cues; Esc quits.
+Exit codes: 0 done, 2 bad input (named), 3 no display or OpenGL 3.3, or an unattended run timed out.
+)";
+
+namespace {
+
+double number(const std::string& option, const std::string& text, double lo, double hi) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || errno != 0 || !std::isfinite(v) || v < lo || v > hi) {
+    throw InputError(option + ": expected a number in [" + std::to_string(lo) + ", " +
+                     std::to_string(hi) + "], got '" + text + "'");
+  }
+  return v;
+}
+
+}  // namespace
+
+std::filesystem::path drill_scenario(const std::string& drill) {
+  const std::string name = drill == "incision"    ? "corneal_incision"
+                           : drill == "rhexis"    ? "capsulorhexis"
+                           : drill == "sculpting" ? "phaco_sculpting"
+                                                  : drill;
+  if (name != "corneal_incision" && name != "capsulorhexis" && name != "phaco_sculpting") {
+    throw InputError("--drill: unknown drill '" + drill +
+                     "'; expected corneal_incision, capsulorhexis or phaco_sculpting");
+  }
+  return eye::data_dir() / "scenarios" / (name + "_expert.json");
+}
+
+TrainerOptions parse_options(const std::vector<std::string>& raw) {
+  const cli::Args a =
+      cli::parse_args("phaco-trainer", raw,
+                      {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee",
+                       "--db", "--size", "--threads", "--cache-dir", "--screenshot", "--after",
+                       "--stats", "--stats-after", "--timeout"},
+                      {"--stereo", "--no-guidance", "--no-ui", "--no-render"});
+  if (!a.positional.empty()) {
+    throw InputError("phaco-trainer: unexpected argument '" + a.positional[0] +
+                     "' (give a scenario with --scenario)");
+  }
+  TrainerOptions o;
+  if (a.option("--drill") && a.option("--scenario")) {
+    throw InputError("phaco-trainer: give --drill or --scenario, not both");
+  }
+  o.scenario = a.option("--scenario")
+                   ? std::filesystem::path(*a.option("--scenario"))
+                   : drill_scenario(a.option("--drill").value_or("capsulorhexis"));
+  if (auto v = a.option("--difficulty")) o.difficulty = *v;
+  if (auto v = a.option("--left")) o.left = *v;
+  if (auto v = a.option("--right")) o.right = *v;
+  if (auto v = a.option("--trainee")) o.trainee = *v;
+  if (auto v = a.option("--db")) o.db = *v;
+  if (auto v = a.option("--size")) {
+    const auto x = v->find('x');
+    if (x == std::string::npos)
+      throw InputError("--size: expected WxH, e.g. 1280x720, got '" + *v + "'");
+    o.width = static_cast<int>(number("--size", v->substr(0, x), 64, 8192));
+    o.height = static_cast<int>(number("--size", v->substr(x + 1), 64, 8192));
+  }
+  if (auto v = a.option("--threads")) o.threads = static_cast<int>(number("--threads", *v, 1, 64));
+  if (auto v = a.option("--cache-dir")) o.cache_dir = *v;
+  if (auto v = a.option("--screenshot")) o.screenshot = *v;
+  if (auto v = a.option("--after")) o.after_s = number("--after", *v, 0, 3600);
+  if (auto v = a.option("--stats")) o.stats = *v;
+  if (auto v = a.option("--stats-after")) o.stats_after_s = number("--stats-after", *v, 0.5, 3600);
+  if (auto v = a.option("--timeout")) o.timeout_s = number("--timeout", *v, 1, 86400);
+  o.stereo = a.flag("--stereo");
+  o.guidance = !a.flag("--no-guidance");
+  o.ui = !a.flag("--no-ui") && !o.screenshot;  // a screenshot shows the view alone
+  o.render = !a.flag("--no-render");
+  if (!o.render && !o.stats) throw InputError("--no-render: only with --stats (the baseline)");
+  if (o.screenshot && o.stats) throw InputError("phaco-trainer: --screenshot or --stats, not both");
+  if (a.option("--after") && !o.screenshot) throw InputError("--after: only with --screenshot");
+  if (a.option("--stats-after") && !o.stats) throw InputError("--stats-after: only with --stats");
+  return o;
+}
+
+}  // namespace phaco::trainer

@@ -1,0 +1,41 @@
+#pragma once
+// phaco-trainer's command line (issue 8): which drill, how hard, which device per hand, who
+// trains, the window, and the unattended modes the tests and the perf harness use (a screenshot
+// after some simulated seconds; statistics after a while).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace phaco::trainer {
+
+struct TrainerOptions {
+  std::filesystem::path scenario;                   // the drill's layout and tracks
+  std::string difficulty;                           // a level of the drill file ("" = its default)
+  std::string left = "desktop", right = "desktop";  // device per hand (TrainerSession specs)
+  std::string trainee;                              // records the finished drill when set
+  std::filesystem::path db;                         // records database ("" = the default)
+  int width = 1280, height = 720;
+  bool stereo = false, guidance = true, ui = true, render = true;
+  int threads = 1;
+  std::optional<std::filesystem::path> cache_dir;
+  // Unattended: after `after_s` simulated seconds, save the view (no UI) and exit.
+  std::optional<std::filesystem::path> screenshot;
+  double after_s = 5.0;
+  // Unattended: after `stats_after_s` wall seconds, write frame statistics as JSON and exit.
+  std::optional<std::filesystem::path> stats;
+  double stats_after_s = 20.0;
+  double timeout_s = 600.0;  // unattended modes give up (exit 3) after this many wall seconds
+};
+
+extern const char* const kUsage;
+
+// Parses argv (without the program name). Throws InputError naming the option.
+TrainerOptions parse_options(const std::vector<std::string>& args);
+
+// The default scenario of a drill name ("corneal_incision", "capsulorhexis", "phaco_sculpting",
+// or the short "incision", "rhexis", "sculpting"): data/scenarios/<drill>_expert.json, whose
+// tracks give the tools and their starting poses.
+std::filesystem::path drill_scenario(const std::string& drill);
+
+}  // namespace phaco::trainer

@@ -1,0 +1,333 @@
+#include "procedures/trainer/trainer_session.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <future>
+
+#include "engine/core/clock.hpp"
+#include "engine/core/error.hpp"
+#include "engine/core/utc_time.hpp"
+#include "engine/haptics/device_factory.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
+#include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/drill_metrics.hpp"
+#include "procedures/scene/lens_fragments.hpp"
+#include "procedures/scene/lens_sculpting.hpp"
+#include "procedures/scene/run.hpp"
+#include "procedures/trainer/snapshot_fill.hpp"
+
+namespace phaco {
+
+namespace {
+
+size_t at(Hand h) {
+  return static_cast<size_t>(h) & 1u;
+}
+
+bool is_trackless(const std::string& spec) {
+  return spec.empty() || spec == "track";
+}
+
+// The drill's report from the live scene, in the format of `phaco run --report` (to_json of
+// RunReport): what run_scenario collects at its end.
+nlohmann::json live_report(Scene& scene) {
+  RunReport r;
+  r.scenario = scene.scenario.source;
+  r.drill = std::string(to_string(scene.scenario.drill));
+  r.drill_setup = drill_setup_json(scene);
+  r.frames = scene.frame;
+  r.sim_time_s = scene.time_s;
+  r.threads = scene.executor->threads();
+  r.dt_s = scene.scenario.dt_s;
+  for (const auto& t : scene.executor->timings())
+    r.systems.push_back({t.name, t.p50_ms(), t.p99_ms(), 0.0});
+  const auto& f = scene.executor->frame_timing();
+  r.frame = {"frame", f.p50_ms(), f.p99_ms(), 0.0};
+  r.mesh_load_s = scene.mesh_load_s;
+  r.elements = element_counts(scene);
+  r.state_hash = state_hash(scene);
+  if (auto j = capsule_physics_summary(scene); !j.is_null()) r.physics["capsule"] = j;
+  if (auto j = capsule_cutting_summary(scene); !j.is_null()) r.physics["capsule_cutting"] = j;
+  if (auto j = lens_sculpting_summary(scene); !j.is_null()) r.physics["lens_sculpting"] = j;
+  if (auto j = lens_fragments_summary(scene); !j.is_null()) r.physics["lens_fragments"] = j;
+  DrillReport d = drill_report(scene);
+  r.metrics = std::move(d.metrics);
+  r.targets = std::move(d.targets);
+  r.events = std::move(d.events);
+  r.series = std::move(d.series);
+  r.score_terms = std::move(d.score_terms);
+  r.peak_memory_mb = peak_memory_mb();
+  return to_json(r);
+}
+
+}  // namespace
+
+TrainerSession::TrainerSession(TrainerConfig config)
+    : config_(std::move(config)), desktop_(std::make_shared<DesktopInput>(config_.desktop)) {
+  for (const std::string& spec : config_.devices) {
+    if (spec == "desktop" || is_trackless(spec)) continue;
+    parse_device_spec(spec);  // throws InputError naming the spec
+  }
+  if (config_.duration_s < 0 || !std::isfinite(config_.duration_s))
+    throw InputError("trainer: duration must be ≥ 0 s");
+}
+
+TrainerSession::~TrainerSession() {
+  stop();
+}
+
+void TrainerSession::start() {
+  Scenario scenario = config_.scenario;
+  if (config_.duration_s > 0) scenario.duration_s = config_.duration_s;
+  launch(scenario, config_.devices);
+}
+
+void TrainerSession::launch(const Scenario& scenario, const std::array<std::string, 2>& devices) {
+  stop();
+  launched_scenario_ = scenario;
+  launched_devices_ = devices;
+  running_scenario_ = scenario;
+  running_devices_ = devices;
+  if (!config_.trainee.empty()) {
+    // Fail before the drill, not after it: the database opens and the name is acceptable.
+    check_session_record_target(
+        config_.records_db.empty() ? trainer_records_db() : config_.records_db, config_.trainee);
+  }
+  haptics_ = std::make_unique<HapticSession>(config_.haptics);
+  clock_.paused.store(false, std::memory_order_relaxed);
+  clock_.paused_ns.store(0, std::memory_order_relaxed);
+  const double duration = running_scenario_.duration_s;
+  for (Hand h : {Hand::Left, Hand::Right}) {
+    recorders_[at(h)].reset();
+    const std::string& spec = devices[at(h)];
+    const HandTrack* track = running_scenario_.find_hand(h);
+    if (!track || is_trackless(spec)) continue;
+    std::unique_ptr<Device> device;
+    if (spec == "desktop") {
+      desktop_->set_start(h, track->tool, sample_track(track->track, 0.0));
+      device = std::make_unique<DesktopDevice>(desktop_, h);
+    } else {
+      DeviceContext context;
+      context.scenario = &running_scenario_;
+      context.hand = h;
+      device = make_device(spec, context);
+    }
+    // Capacity for the whole run at 1 kHz with a margin: recording never allocates.
+    recorders_[at(h)] =
+        std::make_unique<DeviceRecorder>(static_cast<std::size_t>(duration * 1500) + 4096);
+    haptics_->attach(h, recording_device(std::move(device), *recorders_[at(h)], clock_));
+  }
+  TrainerEvent stale;
+  while (events_.try_pop(stale)) {
+  }
+  stop_.store(false, std::memory_order_relaxed);
+  pause_.store(false, std::memory_order_relaxed);
+  failed_.store(false, std::memory_order_relaxed);
+  error_.clear();
+  end_report_ = nlohmann::json::object();
+  end_frames_ = 0;
+  events_seen_ = 0;
+  rate_t0_ns_ = 0;
+  frame_.store(0, std::memory_order_relaxed);
+  sim_time_s_.store(0, std::memory_order_relaxed);
+  sim_rate_hz_.store(0, std::memory_order_relaxed);
+  state_.store(static_cast<uint8_t>(TrainerState::Running), std::memory_order_release);
+
+  auto started = std::make_shared<std::promise<void>>();
+  std::future<void> ready = started->get_future();
+  sim_ = std::thread([this, started] {
+    bool signalled = false;
+    try {
+      SceneOptions options = config_.scene;
+      RealtimeRunOptions run;
+      // run_realtime steps once before its clock starts (the first model): the scenario's frame
+      // count in all, as `phaco run` steps, so a run on tracks alone matches it bit for bit.
+      const double dt = running_scenario_.dt_s;
+      run.duration_s = std::max(running_scenario_.duration_s - dt, dt);
+      run.loop_scenario = false;
+      run.stop = &stop_;
+      run.pause = &pause_;
+      run.after_frame = [this, &started, &signalled](Scene& scene) {
+        after_frame(scene);
+        if (!signalled) started->set_value(), signalled = true;
+      };
+      run.at_end = [this](Scene& scene) { at_end(scene, nullptr); };
+      const RealtimeRunReport report = run_realtime(running_scenario_, options, *haptics_, run);
+      end_report_["live"] = to_json(report);
+      end_report_["live"]["wall_s"] = report.wall_s;
+    } catch (const std::exception& e) {
+      error_ = e.what();
+      failed_.store(true, std::memory_order_release);
+      if (!signalled) started->set_exception(std::current_exception()), signalled = true;
+    }
+    state_.store(
+        static_cast<uint8_t>(failed_.load(std::memory_order_relaxed) ? TrainerState::Idle
+                                                                     : TrainerState::Ended),
+        std::memory_order_release);
+  });
+  try {
+    ready.get();  // the scene is built and its first snapshot published (or it failed)
+    unfinished_ = true;
+  } catch (...) {
+    join();
+    throw;
+  }
+}
+
+void TrainerSession::after_frame(Scene& scene) {
+  render::RenderSnapshot& snap = snapshots_.write_slot();
+  fill_snapshot(scene, snap);
+  const Hand selected = desktop_->selected();
+  for (render::ToolView& t : snap.tools)
+    t.selected = running_devices_[at(t.hand)] == "desktop" && t.hand == selected;
+  snapshots_.publish();
+  // Relaxed: figures for display; nothing is read on their strength.
+  snapshots_published_.fetch_add(1, std::memory_order_relaxed);
+  frame_.store(scene.frame, std::memory_order_relaxed);
+  sim_time_s_.store(scene.time_s, std::memory_order_relaxed);
+  const int64_t now = now_ns();
+  if (rate_t0_ns_ == 0) {
+    rate_t0_ns_ = now, rate_frame0_ = scene.frame;
+  } else if (now - rate_t0_ns_ >= 500'000'000) {
+    sim_rate_hz_.store(static_cast<double>(scene.frame - rate_frame0_) * 1e9 /
+                           static_cast<double>(now - rate_t0_ns_),
+                       std::memory_order_relaxed);
+    rate_t0_ns_ = now, rate_frame0_ = scene.frame;
+  }
+  for (const size_t n = drill_event_count(scene); events_seen_ < n; ++events_seen_) {
+    const LiveDrillEvent e = drill_event(scene, events_seen_);
+    events_.try_push({e.t_s, e.kind, e.hand, e.detail, e.value});  // full: dropped, counted
+  }
+}
+
+void TrainerSession::at_end(Scene& scene, const RealtimeRunReport*) {
+  end_report_ = live_report(scene);
+  end_frames_ = scene.frame;
+}
+
+void TrainerSession::join() {
+  if (sim_.joinable()) sim_.join();
+}
+
+void TrainerSession::stop() {
+  unfinished_ = false;
+  stop_.store(true, std::memory_order_release);
+  pause_.store(false, std::memory_order_release);
+  join();
+  if (state() != TrainerState::Idle)
+    state_.store(static_cast<uint8_t>(TrainerState::Idle), std::memory_order_release);
+}
+
+TrainerState TrainerSession::state() const {
+  return static_cast<TrainerState>(state_.load(std::memory_order_acquire));
+}
+
+void TrainerSession::pause() {
+  if (state() != TrainerState::Running) return;
+  paused_at_ns_ = now_ns();
+  clock_.paused.store(true, std::memory_order_relaxed);
+  pause_.store(true, std::memory_order_release);
+  state_.store(static_cast<uint8_t>(TrainerState::Paused), std::memory_order_release);
+}
+
+void TrainerSession::resume() {
+  if (state() != TrainerState::Paused) return;
+  clock_.paused_ns.fetch_add(now_ns() - paused_at_ns_, std::memory_order_relaxed);
+  clock_.paused.store(false, std::memory_order_relaxed);
+  state_.store(static_cast<uint8_t>(TrainerState::Running), std::memory_order_release);
+  pause_.store(false, std::memory_order_release);
+}
+
+void TrainerSession::reset() {
+  if (!launched_scenario_) return start();
+  // Copies: launch() overwrites the members they come from.
+  const Scenario scenario = *launched_scenario_;
+  const std::array<std::string, 2> devices = launched_devices_;
+  launch(scenario, devices);
+}
+
+nlohmann::json TrainerSession::finish() {
+  if (!unfinished_) throw InputError("trainer: finish() without a run: start() first");
+  unfinished_ = false;
+  stop_.store(true, std::memory_order_release);
+  pause_.store(false, std::memory_order_release);
+  join();
+  state_.store(static_cast<uint8_t>(TrainerState::Idle), std::memory_order_release);
+  if (failed_.load(std::memory_order_acquire)) throw InputError("trainer: " + error_);
+
+  nlohmann::json report = end_report_;
+  const double dt = running_scenario_.dt_s;
+  // The recording: the scenario with every device-driven hand's track replaced by what its
+  // device produced, as long as the simulated run (not the script).
+  Scenario recorded = running_scenario_;
+  nlohmann::json from = nlohmann::json::object();
+  for (Hand h : {Hand::Left, Hand::Right}) {
+    const DeviceRecorder* r = recorders_[at(h)].get();
+    const HandTrack* track = running_scenario_.find_hand(h);
+    if (!track) continue;
+    from[std::string(to_string(h))] = {{"device", running_devices_[at(h)]},
+                                       {"samples", r ? r->size() : 0},
+                                       {"dropped", r ? r->dropped() : 0}};
+    if (r && r->size() > 0) recorded = r->scenario(recorded, h, track->tool);
+  }
+  recorded.duration_s = std::max(static_cast<double>(end_frames_) * dt, dt);
+  recorded.description = "Recorded in the trainer; " + recorded.description;
+  last_recording_ = recorded;
+
+  if (!config_.trainee.empty()) {
+    // The stored report is the fixed-step replay of the recording: replaying the record gives
+    // its metrics and state hash exactly (docs/records.md).
+    SceneOptions options = config_.scene;
+    options.haptics = nullptr;
+    nlohmann::json j = to_json(run_scenario(recorded, options));
+    j["date"] = utc_now();
+    j["live"] = report.value("live", nlohmann::json::object());
+    j["live_metrics"] = report.value("metrics", nlohmann::json::object());
+    j["live_state_hash"] = report.value("state_hash", std::string());
+    j["recorded_from"] = from;
+    const std::filesystem::path db =
+        config_.records_db.empty() ? trainer_records_db() : config_.records_db;
+    j["record_id"] = store_session_record(db, config_.trainee, recorded, j);
+    report = std::move(j);
+  } else {
+    report["recorded_from"] = from;
+  }
+  last_report_ = report;
+  return report;
+}
+
+void TrainerSession::replay_last() {
+  if (!last_recording_) throw InputError("trainer: nothing to replay: no run was finished");
+  const Scenario recording = *last_recording_;
+  launch(recording, {"track", "track"});
+}
+
+const render::RenderSnapshot* TrainerSession::newest_snapshot() {
+  if (snapshots_.acquire()) have_snapshot_ = true;
+  return have_snapshot_ ? &snapshots_.read_slot() : nullptr;
+}
+
+TrainerStatus TrainerSession::status() const {
+  TrainerStatus s;
+  s.state = state();
+  s.frame = frame_.load(std::memory_order_relaxed);
+  s.sim_time_s = sim_time_s_.load(std::memory_order_relaxed);
+  s.duration_s = running_scenario_.duration_s;
+  s.sim_rate_hz = sim_rate_hz_.load(std::memory_order_relaxed);
+  s.snapshots_published = snapshots_published_.load(std::memory_order_relaxed);
+  s.events_dropped = events_.dropped();
+  if (haptics_) {
+    const HapticSessionStats h = haptics_->stats();
+    s.haptic_period_p50_us = h.loop.period.p50_us;
+    s.haptic_period_p99_us = h.loop.period.p99_us;
+    s.haptic_ticks = h.loop.ticks;
+  }
+  if (failed_.load(std::memory_order_acquire)) s.error = error_;
+  return s;
+}
+
+size_t TrainerSession::poll_events(std::vector<TrainerEvent>& out) {
+  return events_.drain([&out](const TrainerEvent& e) { out.push_back(e); });
+}
+
+}  // namespace phaco
