@@ -9,6 +9,7 @@
 //                           (Hausdorff, remeshing), scripted capsulorhexis opening per level
 //   phaco-perf haptics      issue 6: the 1 kHz haptic thread beside the scene, the local model
 //   phaco-perf drills       issue 7: expert and novice drills, difficulty levels, comparisons
+//   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
 //   phaco-perf all          every study above, in that order
 //
 // Every study takes --quick (small levels, few steps, about a minute) and --out-dir DIR (default
@@ -71,8 +72,12 @@ studies:
       systems; the capsulorhexis and sculpting experts at every difficulty level of their drill
       files; every novice against its drill's expert by dynamic time warping. About 2 minutes
       (quick: one expert and one novice per drill, one level).
+  trainer
+      Issue 8, phaco-trainer under Xvfb on Mesa's software renderer at 1280x720, each drill with
+      scripted hands: render frame rate and frame times, simulation rate and haptic period, with
+      and without rendering. About 2 minutes (quick 30 s). Needs xvfb-run.
   all
-      foundation, bandwidth, membrane, cut, lens, haptics, drills.
+      foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -115,6 +120,8 @@ int main(int argc, char** argv) {
       perf::run_haptics(options);
     } else if (cmd == "drills") {
       perf::run_drills(options);
+    } else if (cmd == "trainer") {
+      perf::run_trainer_study(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");
@@ -125,6 +132,7 @@ int main(int argc, char** argv) {
       perf::run_lens(options);
       perf::run_haptics(options);
       perf::run_drills(options);
+      perf::run_trainer_study(options);
     } else {
       std::fprintf(stderr, "phaco-perf: unknown study '%s' (try --help)\n", cmd.c_str());
       return 2;

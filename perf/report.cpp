@@ -74,7 +74,7 @@ void write_json(const Table& t, const fs::path& file) {
 
 const std::vector<std::string>& study_order() {
   static const std::vector<std::string> order = {"foundation", "bandwidth", "membrane", "cut",
-                                                 "lens", "haptics", "drills"};
+                                                 "lens", "haptics", "drills", "trainer"};
   return order;
 }
 

@@ -21,6 +21,7 @@ void run_cut(const StudyOptions& options);
 void run_lens(const StudyOptions& options);
 void run_haptics(const StudyOptions& options);
 void run_drills(const StudyOptions& options);
+void run_trainer_study(const StudyOptions& options);
 
 // Rewrites out_dir/RESULTS.md from the machine description and the sections in out_dir/results.
 void regenerate_results(const std::filesystem::path& out_dir);

@@ -1,45 +1,16 @@
 #include "apps/phaco/haptic_record.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
-#include <ctime>
 
-#include "apps/phaco/records_commands.hpp"
 #include "engine/core/error.hpp"
 #include "engine/core/utc_time.hpp"
+#include "engine/haptics/recording_device.hpp"
+#include "engine/records/record_run.hpp"
 #include "procedures/scene/run.hpp"
 
 namespace phaco::cli {
-
-namespace {
-
-// Forwards every call; what read() returns is also recorded (DeviceRecorder keeps new samples
-// only, so the haptic thread's repeated reads of one sample are one track sample).
-class RecordingDevice final : public Device {
- public:
-  RecordingDevice(std::unique_ptr<Device> inner, DeviceRecorder& recorder)
-      : inner_(std::move(inner)), recorder_(recorder) {}
-  std::string_view name() const override { return inner_->name(); }
-  DeviceLimits limits() const override { return inner_->limits(); }
-  void start(int64_t now_ns) override { inner_->start(now_ns); }
-  void stop() override { inner_->stop(); }
-  bool read(int64_t now_ns, DeviceSample& out) override {
-    const bool got = inner_->read(now_ns, out);
-    if (got) recorder_.record(out);
-    return got;
-  }
-  void write_force(const Vec3& force_mn, int64_t now_ns) override {
-    inner_->write_force(force_mn, now_ns);
-  }
-  DeviceHealth health(int64_t now_ns) const override { return inner_->health(now_ns); }
-  DeviceCounters counters() const override { return inner_->counters(); }
-
- private:
-  std::unique_ptr<Device> inner_;
-  DeviceRecorder& recorder_;
-};
-
-}  // namespace
 
 std::unique_ptr<HapticRecording> HapticRecording::from_args(const Args& a, const Scenario& scenario,
                                                             Hand hand, const std::string& spec) {
@@ -73,7 +44,7 @@ std::unique_ptr<HapticRecording> HapticRecording::from_args(const Args& a, const
 }
 
 std::unique_ptr<Device> HapticRecording::wrap(std::unique_ptr<Device> device) {
-  return std::make_unique<RecordingDevice>(std::move(device), *recorder_);
+  return recording_device(std::move(device), *recorder_);
 }
 
 int64_t HapticRecording::store(const Scenario& scenario, const SceneOptions& options,

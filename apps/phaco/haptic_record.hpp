@@ -4,13 +4,14 @@
 // replaced by the track the device actually produced.
 //
 // The device is wrapped so every sample the haptic thread reads also goes to a DeviceRecorder
-// (engine/haptics/replay_device.hpp; no allocation on the haptic thread, capacity reserved up
+// (engine/haptics/recording_device.hpp; no allocation on the haptic thread, capacity reserved up
 // front). After the live run the recorded track becomes the scenario (duration: the live run's),
 // that scenario is run once more at the fixed step, headless, and the record stores it with that
 // replay's metrics and state hash, plus the live run's real-time report under "live". So
 // `phaco export ID --scenario` followed by `phaco run` reproduces the stored metrics and hash
 // exactly; the live run's own steps were paced by the wall clock and may differ (docs/records.md).
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>

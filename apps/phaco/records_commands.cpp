@@ -1,13 +1,12 @@
 #include "apps/phaco/records_commands.hpp"
 
-#include <algorithm>
 #include <charconv>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
 
 #include "apps/phaco/args.hpp"
 #include "apps/phaco/commands.hpp"
@@ -98,35 +97,7 @@ std::map<std::string, Trend> trends(const std::vector<SessionRecord>& records) {
   return out;
 }
 
-void check_trainee(const std::string& trainee) {
-  if (trainee.empty()) throw InputError("run: --trainee needs a name");
-  if (trainee.size() > 200) throw InputError("run: --trainee name is longer than 200 characters");
-  for (const char c : trainee) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      throw InputError("run: --trainee name contains a control character");
-    }
-  }
-}
-
-void make_parent_dir(const fs::path& db) {
-  if (!db.has_parent_path()) return;
-  std::error_code ec;
-  fs::create_directories(db.parent_path(), ec);
-  if (ec) throw InputError("cannot create '" + db.parent_path().string() + "': " + ec.message());
-}
-
 }  // namespace
-
-fs::path default_records_db() {
-  if (const char* env = std::getenv("PHACO_RECORDS_DB"); env && *env) return env;
-  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg) {
-    return fs::path(xdg) / "openphaco" / "records.sqlite";
-  }
-  if (const char* home = std::getenv("HOME"); home && *home) {
-    return fs::path(home) / ".local" / "share" / "openphaco" / "records.sqlite";
-  }
-  throw InputError("no records database: give --db FILE or set PHACO_RECORDS_DB");
-}
 
 int history(const std::vector<std::string>& raw) {
   const Args a = parse_args("history", raw, {"--db"}, {"--json"});
@@ -235,51 +206,6 @@ int export_record(const std::vector<std::string>& raw) {
                 static_cast<long long>(id), scen->c_str(), scen->c_str());
   }
   return kOk;
-}
-
-void check_record_target(const fs::path& db, const std::string& trainee) {
-  check_trainee(trainee);
-  make_parent_dir(db);
-  const RecordStore store(db, OpenMode::CreateIfMissing);
-}
-
-int64_t record_run(const fs::path& db, const std::string& trainee, const Scenario& scenario,
-                   const json& report) {
-  check_trainee(trainee);
-  SessionRecord r;
-  r.trainee = trainee;
-  r.drill = std::string(to_string(scenario.drill));
-  r.scenario_name =
-      scenario.name.empty() ? fs::path(scenario.source).stem().string() : scenario.name;
-  // The run ends now; it started the stepping and mesh-loading time ago (the report's own clock).
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  const double now = static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-  double took = 0;
-  for (const char* k : {"wall_time_s", "mesh_load_s"}) {
-    if (report.contains(k) && report[k].is_number() && std::isfinite(report[k].get<double>())) {
-      took += std::max(0.0, report[k].get<double>());
-    }
-  }
-  r.started_utc = format_utc(now - took);
-  r.finished_utc = format_utc(now);
-  r.recording = to_json(scenario);
-  // Settings: the recording less its tracks, names and drill (a column of its own) — eye,
-  // methods, seed, dt, duration and whatever the scenario format gains (difficulty), without a
-  // list to keep in step.
-  r.settings = r.recording;
-  for (const char* k : {"hands", "name", "description", "drill"}) r.settings.erase(k);
-  if (report.contains("metrics") && report["metrics"].is_object()) r.metrics = report["metrics"];
-  if (r.metrics.contains("score") && r.metrics["score"].is_number()) {
-    r.score = r.metrics["score"].get<double>();
-  }
-  if (report.contains("state_hash") && report["state_hash"].is_string()) {
-    r.state_hash = report["state_hash"].get<std::string>();
-  }
-  r.report = report.is_object() ? report : json::object();
-  make_parent_dir(db);
-  RecordStore store(db, OpenMode::CreateIfMissing);
-  return store.add_record(r);
 }
 
 }  // namespace phaco::cli

@@ -22,6 +22,7 @@
 #include "engine/core/error.hpp"
 #include "engine/render/offscreen.hpp"
 #include "engine/render/renderer.hpp"
+#include "procedures/scene/scene.hpp"
 #include "procedures/trainer/trainer_session.hpp"
 
 namespace phaco::trainer {
@@ -82,7 +83,17 @@ TrainerConfig config_of(const TrainerOptions& o) {
   TrainerConfig c;
   c.scenario = load_scenario(o.scenario);
   if (!o.difficulty.empty()) c.scenario.difficulty = o.difficulty;
+  // The drill file and the level are checked now, before a window opens.
+  resolve_difficulty(load_drill_for(c.scenario), c.scenario.difficulty,
+                     c.scenario.difficulty_settings, c.scenario.source);
   c.devices = {o.left, o.right};
+  // A trainee's hands need time; a scripted drill ends with its script.
+  const auto scripted = [](const std::string& d) {
+    return d == "scripted" || d == "track" || d.rfind("replay:", 0) == 0;
+  };
+  c.duration_s = o.duration_s > 0                        ? o.duration_s
+                 : scripted(o.left) && scripted(o.right) ? 0.0
+                                                         : 900.0;
   c.scene.threads = o.threads;
   c.scene.cache_dir = o.cache_dir;
   c.trainee = o.trainee;

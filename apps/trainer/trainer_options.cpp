@@ -15,7 +15,7 @@ const char* const kUsage = R"(phaco-trainer — OpenPhaco's cataract-surgery tra
 usage:
   phaco-trainer [--drill NAME | --scenario FILE] [--difficulty LEVEL] [--trainee NAME] [--db DB]
                 [--left DEVICE] [--right DEVICE] [--size WxH] [--stereo] [--no-guidance]
-                [--threads N] [--cache-dir DIR]
+                [--duration S] [--threads N] [--cache-dir DIR]
   phaco-trainer ... --screenshot OUT.png [--after SECONDS] [--no-ui]
   phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
   phaco-trainer --help
@@ -27,6 +27,8 @@ usage:
   --left/--right  the hand's device: desktop (mouse, keyboard, gamepad; default), scripted (the
                 scenario's track in real time through the 1 kHz loop), track (the scene plays the
                 track), replay:FILE, udp:LOCALPORT@HOST:PORT, openhaptics[:NAME]
+  --duration    simulated seconds before the drill ends (default: the scenario's when every hand
+                plays a script, else 900)
   --trainee     store each finished drill in the records database (phaco history NAME)
   --screenshot  run unattended: save the view after --after simulated seconds (default 5), exit
   --stats       run unattended: after --stats-after wall seconds (default 20) write the render
@@ -71,7 +73,7 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
       cli::parse_args("phaco-trainer", raw,
                       {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee",
                        "--db", "--size", "--threads", "--cache-dir", "--screenshot", "--after",
-                       "--stats", "--stats-after", "--timeout"},
+                       "--stats", "--stats-after", "--duration", "--timeout"},
                       {"--stereo", "--no-guidance", "--no-ui", "--no-render"});
   if (!a.positional.empty()) {
     throw InputError("phaco-trainer: unexpected argument '" + a.positional[0] +
@@ -98,6 +100,7 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   }
   if (auto v = a.option("--threads")) o.threads = static_cast<int>(number("--threads", *v, 1, 64));
   if (auto v = a.option("--cache-dir")) o.cache_dir = *v;
+  if (auto v = a.option("--duration")) o.duration_s = number("--duration", *v, 1, 86400);
   if (auto v = a.option("--screenshot")) o.screenshot = *v;
   if (auto v = a.option("--after")) o.after_s = number("--after", *v, 0, 3600);
   if (auto v = a.option("--stats")) o.stats = *v;

@@ -18,6 +18,9 @@ struct TrainerOptions {
   int width = 1280, height = 720;
   bool stereo = false, guidance = true, ui = true, render = true;
   int threads = 1;
+  // Simulated seconds before the drill ends by itself; 0: the scenario's duration when every
+  // hand plays its script (scripted, track, replay), else 15 minutes for a trainee.
+  double duration_s = 0;
   std::optional<std::filesystem::path> cache_dir;
   // Unattended: after `after_s` simulated seconds, save the view (no UI) and exit.
   std::optional<std::filesystem::path> screenshot;

@@ -8,10 +8,10 @@
 #include <fstream>
 
 #include "engine/core/error.hpp"
+#include "engine/records/record_run.hpp"
 #include "engine/records/records.hpp"
 #include "procedures/report/html_report.hpp"
 #include "procedures/scene/scene.hpp"
-#include "procedures/trainer/trainer_record.hpp"
 
 namespace phaco::trainer {
 
@@ -61,23 +61,24 @@ UiAction TrainerUi::draw(TrainerSession& session, render::Renderer& renderer,
                          render::Microscope& microscope, double frame_ms) {
   UiAction action = UiAction::None;
   // A drill that reached its end is finished once: its score and report appear.
-  if (session.state() == TrainerState::Ended && !finished_) {
-    try {
-      report_ = session.finish();
-      finished_ = true;
-      message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
-                                               : std::string("finished (not stored: no trainee)");
-    } catch (const InputError& e) {
-      message_ = e.what();
-      finished_ = true;
-    }
-  }
+  if (session.state() == TrainerState::Ended && !finished_) finish(session);
   drill_panel(session, action);
   live_panel(session, frame_ms);
   result_panel(session);
   history_panel();
   view_panel(renderer, microscope);
   return action;
+}
+
+void TrainerUi::finish(TrainerSession& session) {
+  finished_ = true;  // once, also when it fails: the message says why
+  try {
+    report_ = session.finish();
+    message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
+                                             : std::string("finished (not stored: no trainee)");
+  } catch (const InputError& e) {
+    message_ = e.what();
+  }
 }
 
 void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
@@ -122,16 +123,7 @@ void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
     events_.clear();
     session.reset();
   }
-  if (ImGui::Button("Finish") && state != TrainerState::Idle && !finished_) {
-    try {
-      report_ = session.finish();
-      finished_ = true;
-      message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
-                                               : std::string("finished (not stored: no trainee)");
-    } catch (const InputError& e) {
-      message_ = e.what();
-    }
-  }
+  if (ImGui::Button("Finish") && state != TrainerState::Idle && !finished_) finish(session);
   ImGui::SameLine();
   if (ImGui::Button("Replay last")) {
     try {
@@ -229,7 +221,7 @@ void TrainerUi::history_panel() {
   if (ImGui::Button("Load") && trainee_[0] != '\0') {
     history_ = nlohmann::json::array();
     try {
-      const std::filesystem::path db = options_.db.empty() ? trainer_records_db() : options_.db;
+      const std::filesystem::path db = options_.db.empty() ? default_records_db() : options_.db;
       if (std::filesystem::exists(db)) {
         RecordStore store(db, OpenMode::ExistingOnly);
         for (const SessionRecord& r : store.records_of(trainee_)) {

@@ -29,6 +29,7 @@ class TrainerUi {
   const TrainerConfig& config() const { return config_; }
 
  private:
+  void finish(TrainerSession& session);  // the drill's report (and record), once
   void drill_panel(TrainerSession& session, UiAction& action);
   void live_panel(TrainerSession& session, double frame_ms);
   void result_panel(TrainerSession& session);

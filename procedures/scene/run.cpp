@@ -36,31 +36,36 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
   const uint64_t frames = scenario.frame_count();
   Stopwatch wall;
   for (uint64_t f = 0; f < frames; ++f) step(*scene);
+  const double wall_s = wall.elapsed_s();
+  RunReport r = report_of(*scene);
+  r.wall_time_s = wall_s;
+  return r;
+}
 
+RunReport report_of(Scene& scene) {
   RunReport r;
-  r.wall_time_s = wall.elapsed_s();
-  r.scenario = scenario.source;
-  r.drill = std::string(to_string(scenario.drill));
-  r.drill_setup = drill_setup_json(*scene);
-  r.frames = frames;
-  r.sim_time_s = scene->time_s;
-  r.threads = scene->executor->threads();
-  r.dt_s = scenario.dt_s;
-  for (const auto& t : scene->executor->timings()) r.systems.push_back(cost_of(t));
-  r.frame = cost_of(scene->executor->frame_timing());
+  r.scenario = scene.scenario.source;
+  r.drill = std::string(to_string(scene.scenario.drill));
+  r.drill_setup = drill_setup_json(scene);
+  r.frames = scene.frame;
+  r.sim_time_s = scene.time_s;
+  r.threads = scene.executor->threads();
+  r.dt_s = scene.scenario.dt_s;
+  for (const auto& t : scene.executor->timings()) r.systems.push_back(cost_of(t));
+  r.frame = cost_of(scene.executor->frame_timing());
   r.frame.name = "frame";
-  r.mesh_load_s = scene->mesh_load_s;
-  r.elements = element_counts(*scene);
-  r.state_hash = state_hash(*scene);
-  if (auto capsule = capsule_physics_summary(*scene); !capsule.is_null())
+  r.mesh_load_s = scene.mesh_load_s;
+  r.elements = element_counts(scene);
+  r.state_hash = state_hash(scene);
+  if (auto capsule = capsule_physics_summary(scene); !capsule.is_null())
     r.physics["capsule"] = capsule;
-  if (auto cutting = capsule_cutting_summary(*scene); !cutting.is_null())
+  if (auto cutting = capsule_cutting_summary(scene); !cutting.is_null())
     r.physics["capsule_cutting"] = cutting;
-  if (auto lens = lens_sculpting_summary(*scene); !lens.is_null())
+  if (auto lens = lens_sculpting_summary(scene); !lens.is_null())
     r.physics["lens_sculpting"] = lens;
-  if (auto lens = lens_fragments_summary(*scene); !lens.is_null())
+  if (auto lens = lens_fragments_summary(scene); !lens.is_null())
     r.physics["lens_fragments"] = lens;
-  DrillReport drill = drill_report(*scene);
+  DrillReport drill = drill_report(scene);
   r.metrics = std::move(drill.metrics);
   r.targets = std::move(drill.targets);
   r.events = std::move(drill.events);

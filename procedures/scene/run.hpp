@@ -43,6 +43,10 @@ struct RunReport {
 };
 
 RunReport run_scenario(const Scenario& scenario, const SceneOptions& options);
+// The report of a scene as it stands (run_scenario's, after its last step; the trainer's live
+// scene at its end): what ran, each system's cost, the sizes, the drill's metrics, the physics
+// summaries and the state hash. wall_time_s is left 0: only the caller knows what it timed.
+RunReport report_of(Scene& scene);
 nlohmann::json to_json(const RunReport& report);
 std::string summary_text(const RunReport& report);
 // Peak resident set size of this process so far, MiB.

@@ -8,11 +8,8 @@
 #include "engine/core/error.hpp"
 #include "engine/core/utc_time.hpp"
 #include "engine/haptics/device_factory.hpp"
-#include "procedures/scene/capsule_cutting.hpp"
-#include "procedures/scene/capsule_physics.hpp"
+#include "engine/records/record_run.hpp"
 #include "procedures/scene/drill_metrics.hpp"
-#include "procedures/scene/lens_fragments.hpp"
-#include "procedures/scene/lens_sculpting.hpp"
 #include "procedures/scene/run.hpp"
 #include "procedures/trainer/snapshot_fill.hpp"
 
@@ -26,38 +23,6 @@ size_t at(Hand h) {
 
 bool is_trackless(const std::string& spec) {
   return spec.empty() || spec == "track";
-}
-
-// The drill's report from the live scene, in the format of `phaco run --report` (to_json of
-// RunReport): what run_scenario collects at its end.
-nlohmann::json live_report(Scene& scene) {
-  RunReport r;
-  r.scenario = scene.scenario.source;
-  r.drill = std::string(to_string(scene.scenario.drill));
-  r.drill_setup = drill_setup_json(scene);
-  r.frames = scene.frame;
-  r.sim_time_s = scene.time_s;
-  r.threads = scene.executor->threads();
-  r.dt_s = scene.scenario.dt_s;
-  for (const auto& t : scene.executor->timings())
-    r.systems.push_back({t.name, t.p50_ms(), t.p99_ms(), 0.0});
-  const auto& f = scene.executor->frame_timing();
-  r.frame = {"frame", f.p50_ms(), f.p99_ms(), 0.0};
-  r.mesh_load_s = scene.mesh_load_s;
-  r.elements = element_counts(scene);
-  r.state_hash = state_hash(scene);
-  if (auto j = capsule_physics_summary(scene); !j.is_null()) r.physics["capsule"] = j;
-  if (auto j = capsule_cutting_summary(scene); !j.is_null()) r.physics["capsule_cutting"] = j;
-  if (auto j = lens_sculpting_summary(scene); !j.is_null()) r.physics["lens_sculpting"] = j;
-  if (auto j = lens_fragments_summary(scene); !j.is_null()) r.physics["lens_fragments"] = j;
-  DrillReport d = drill_report(scene);
-  r.metrics = std::move(d.metrics);
-  r.targets = std::move(d.targets);
-  r.events = std::move(d.events);
-  r.series = std::move(d.series);
-  r.score_terms = std::move(d.score_terms);
-  r.peak_memory_mb = peak_memory_mb();
-  return to_json(r);
 }
 
 }  // namespace
@@ -90,8 +55,8 @@ void TrainerSession::launch(const Scenario& scenario, const std::array<std::stri
   running_devices_ = devices;
   if (!config_.trainee.empty()) {
     // Fail before the drill, not after it: the database opens and the name is acceptable.
-    check_session_record_target(
-        config_.records_db.empty() ? trainer_records_db() : config_.records_db, config_.trainee);
+    check_record_target(config_.records_db.empty() ? default_records_db() : config_.records_db,
+                        config_.trainee);
   }
   haptics_ = std::make_unique<HapticSession>(config_.haptics);
   clock_.paused.store(false, std::memory_order_relaxed);
@@ -115,7 +80,7 @@ void TrainerSession::launch(const Scenario& scenario, const std::array<std::stri
     // Capacity for the whole run at 1 kHz with a margin: recording never allocates.
     recorders_[at(h)] =
         std::make_unique<DeviceRecorder>(static_cast<std::size_t>(duration * 1500) + 4096);
-    haptics_->attach(h, recording_device(std::move(device), *recorders_[at(h)], clock_));
+    haptics_->attach(h, recording_device(std::move(device), *recorders_[at(h)], &clock_));
   }
   TrainerEvent stale;
   while (events_.try_pop(stale)) {
@@ -201,7 +166,7 @@ void TrainerSession::after_frame(Scene& scene) {
 }
 
 void TrainerSession::at_end(Scene& scene, const RealtimeRunReport*) {
-  end_report_ = live_report(scene);
+  end_report_ = to_json(report_of(scene));  // as `phaco run --report`, wall_time_s 0
   end_frames_ = scene.frame;
 }
 
@@ -286,8 +251,9 @@ nlohmann::json TrainerSession::finish() {
     j["live_state_hash"] = report.value("state_hash", std::string());
     j["recorded_from"] = from;
     const std::filesystem::path db =
-        config_.records_db.empty() ? trainer_records_db() : config_.records_db;
-    j["record_id"] = store_session_record(db, config_.trainee, recorded, j);
+        config_.records_db.empty() ? default_records_db() : config_.records_db;
+    // The drill took the live run's wall time (pauses left out), not the replay's.
+    j["record_id"] = record_run(db, config_.trainee, recorded, j, j["live"].value("wall_s", 0.0));
     report = std::move(j);
   } else {
     report["recorded_from"] = from;

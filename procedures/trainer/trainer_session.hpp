@@ -29,6 +29,7 @@
 #include <thread>
 #include <vector>
 
+#include "engine/haptics/recording_device.hpp"
 #include "engine/haptics/spsc_ring.hpp"
 #include "engine/haptics/triple_buffer.hpp"
 #include "engine/render/snapshot.hpp"
@@ -36,7 +37,6 @@
 #include "procedures/haptics/realtime_run.hpp"
 #include "procedures/scene/scene.hpp"
 #include "procedures/trainer/desktop_input.hpp"
-#include "procedures/trainer/trainer_record.hpp"
 
 namespace phaco {
 
@@ -49,7 +49,7 @@ struct TrainerConfig {
   HapticSessionConfig haptics;
   DesktopMapping desktop;
   // finish() stores the run for this trainee (empty: not stored) in `records_db` (empty: the
-  // default, trainer_records_db()).
+  // default, default_records_db() of engine/records/record_run.hpp).
   std::string trainee;
   std::filesystem::path records_db;
 };
