@@ -48,9 +48,12 @@ std::string missed(const nlohmann::json& report) {
 
 // A system's p50 per frame (ms) from the report's systems table; −1 when the scene has none.
 double system_p50_ms(const nlohmann::json& report, const std::string& name) {
-  for (const auto& s : report["systems"])
-    if (s.value("name", "") == name) return s.value("p50_ms", -1.0);
-  return -1;
+  const auto& systems = report["systems"];
+  return systems.contains(name) ? systems[name].value("p50_ms", -1.0) : -1.0;
+}
+
+std::string us(double ms) {
+  return ms < 0 ? std::string("-") : fmt("%.1f", ms * 1e3);
 }
 
 DrillRun run(const fs::path& file, const std::string& difficulty, const fs::path& cache) {
@@ -138,7 +141,7 @@ void run_drills(const StudyOptions& options) {
         "thread; targets and score terms are the drill files' (data/drills, docs/scoring.md).\n\n";
   md +=
       "| scenario | score | misses | key metrics | globe ° / port mN | frame p50 / p99 ms | "
-      "drill_metrics / cut / tool_ports p50 ms |\n|---|---|---|---|---|---|---|\n";
+      "drill_metrics / cut / tool_ports p50 us |\n|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& j = r.report;
     const double cut = std::max(system_p50_ms(j, "capsule_cut"), system_p50_ms(j, "cornea_cut"));
@@ -161,9 +164,9 @@ void run_drills(const StudyOptions& options) {
                  frame_p99 = j["frame"].value("p99_ms", -1.0);
     md += "| " + r.file + " | " + fmt("%.1f", metric(j, "score")) + " | " + missed(j) + " | " +
           key + " | " + f2(metric(j, "globe.max_rotation_deg")) + " / " +
-          fmt("%.1f", metric(j, "ports.max_force_mN")) + " | " + f2(frame_p50) + " / " +
-          f2(frame_p99) + " | " + f3(system_p50_ms(j, "drill_metrics")) + " / " + f3(cut) + " / " +
-          f3(system_p50_ms(j, "tool_ports")) + " |\n";
+          fmt("%.1f", metric(j, "ports.max_force_mN")) + " | " + f3(frame_p50) + " / " +
+          f3(frame_p99) + " | " + us(system_p50_ms(j, "drill_metrics")) + " / " + us(cut) + " / " +
+          us(system_p50_ms(j, "tool_ports")) + " |\n";
     t.add({r.file, r.drill, metric(j, "score"), metric(j, "globe.max_rotation_deg"),
            metric(j, "ports.max_force_mN"), frame_p50, frame_p99, system_p50_ms(j, "drill_metrics"),
            cut, system_p50_ms(j, "tool_ports"), j.value("wall_time_s", -1.0),
