@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
@@ -196,6 +197,27 @@ TEST_F(TrainerCli, IncisionShowsTheScleraAndTheKeratome) {
   expect_eye_in_frame(img);
   expect_tools_at_their_tips(img, "corneal_incision_expert.json", t_s);
   EXPECT_GT(count(img, cv::Rect(0, 0, kWidth, kHeight), sclera), kWidth * kHeight / 8);
+}
+
+// With its panels on, a drill that reaches its end is finished by the UI: scored and stored for the
+// trainee, so `phaco history` lists it (the trainer's records are phaco's).
+TEST_F(TrainerCli, AFinishedDrillIsStoredForTheTrainee) {
+  const fs::path db = out_dir() / "records.sqlite";
+  fs::remove(db);
+  const char* cache = std::getenv("PHACO_CACHE_DIR");
+  const std::string cmd =
+      "xvfb-run -a -s '-screen 0 1280x720x24' " + std::string(PHACO_TRAINER_BIN) +
+      " --drill capsulorhexis --left track --right track --duration 3 --stats " +
+      (out_dir() / "ui_stats.json").string() + " --stats-after 6 --trainee ana --db " +
+      db.string() + (cache ? std::string(" --cache-dir ") + cache : std::string());
+  const ShellResult r = shell(cmd);
+  ASSERT_EQ(r.code, 0) << cmd << "\n" << r.output;
+  const ShellResult h = shell(std::string(PHACO_BIN) + " history ana --json --db " + db.string());
+  ASSERT_EQ(h.code, 0) << h.output;
+  const nlohmann::json j = nlohmann::json::parse(h.output);
+  ASSERT_EQ(j["records"].size(), 1u) << h.output;
+  EXPECT_EQ(j["records"][0]["drill"], "capsulorhexis");
+  EXPECT_TRUE(j["records"][0]["score"].is_number());
 }
 
 TEST(TrainerCliArgs, HelpAndBadInput) {
