@@ -240,18 +240,18 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
 }  // namespace
 
 DrillFile load_drill_for(const Scenario& s) {
-  if (s.drill_file) return load_drill_file(*s.drill_file);  // checked to exist on load
   const std::filesystem::path file =
-      eye::data_dir() / "drills" / (std::string(to_string(s.drill)) + ".json");
+      s.drill_file ? *s.drill_file  // checked to exist when the scenario was read
+                   : eye::data_dir() / "drills" / (std::string(to_string(s.drill)) + ".json");
   if (!std::filesystem::exists(file)) {
     throw InputError(s.source + ": drill: no drill file for '" + std::string(to_string(s.drill)) +
                      "' at " + file.string() + " (give \"drill_file\" or set PHACO_DATA_DIR)");
   }
   DrillFile d = load_drill_file(file);
   if (d.drill != s.drill) {
-    throw InputError(d.source + ": drill: is '" + std::string(to_string(d.drill)) +
-                     "', but the scenario " + s.source + " is '" + std::string(to_string(s.drill)) +
-                     "'");
+    throw InputError(s.source + ": drill_file: " + d.source + " is a '" +
+                     std::string(to_string(d.drill)) + "' drill; the scenario is '" +
+                     std::string(to_string(s.drill)) + "'");
   }
   return d;
 }
@@ -281,11 +281,6 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   auto scene = std::make_unique<Scene>();
   scene->scenario = scenario;
   scene->drill = load_drill_for(scenario);
-  if (scene->drill.drill != scenario.drill) {
-    throw InputError(scenario.source + ": drill_file: " + scene->drill.source + " is a '" +
-                     std::string(to_string(scene->drill.drill)) + "' drill; the scenario is '" +
-                     std::string(to_string(scenario.drill)) + "'");
-  }
   check_tools(scenario, scene->drill);
   scene->difficulty = resolve_difficulty(scene->drill, scenario.difficulty,
                                          scenario.difficulty_settings, scenario.source);

@@ -62,7 +62,7 @@ struct Scene {
 };
 
 // The scenario's drill file: its "drill_file", else eye::data_dir()/drills/<drill>.json. Throws
-// InputError naming the scenario and the file.
+// InputError naming the scenario and the file, also when the file is of another drill.
 DrillFile load_drill_for(const Scenario& scenario);
 
 // {"file", "title", "difficulty": level, "settings": {...}} for the run report.
