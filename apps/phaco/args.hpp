@@ -30,7 +30,8 @@ struct Args {
 
 inline Args parse_args(const std::string& command, const std::vector<std::string>& raw,
                        const std::vector<std::string>& valued,
-                       const std::vector<std::string>& flags) {
+                       const std::vector<std::string>& flags,
+                       const std::string& help = "phaco --help") {
   Args a;
   for (size_t i = 0; i < raw.size(); ++i) {
     const std::string& s = raw[i];
@@ -42,7 +43,7 @@ inline Args parse_args(const std::string& command, const std::vector<std::string
     } else if (std::find(flags.begin(), flags.end(), s) != flags.end()) {
       a.flags.push_back(s);
     } else {
-      throw InputError(command + ": unknown option '" + s + "' (try 'phaco --help')");
+      throw InputError(command + ": unknown option '" + s + "' (try '" + help + "')");
     }
   }
   return a;

@@ -129,6 +129,8 @@ void write_stats(const std::filesystem::path& file, const TrainerOptions& o, con
 
 int run_trainer(const TrainerOptions& o) {
   TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
+  // So are bad device specs and trainee names (the session checks them without building anything).
+  auto session = std::make_unique<TrainerSession>(config);
   Glfw glfw;
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -156,7 +158,6 @@ int run_trainer(const TrainerOptions& o) {
     ro.guidance = o.guidance;
     render::Renderer renderer(ro);
     render::Microscope microscope;
-    auto session = std::make_unique<TrainerSession>(config);
     session->start();
     TrainerUi ui(o, config);
     FrameClock frames;

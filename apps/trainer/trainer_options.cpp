@@ -6,6 +6,7 @@
 
 #include "apps/phaco/args.hpp"
 #include "engine/core/error.hpp"
+#include "engine/io/json_reader.hpp"
 #include "procedures/eye/eye_params.hpp"
 
 namespace phaco::trainer {
@@ -48,8 +49,8 @@ double number(const std::string& option, const std::string& text, double lo, dou
   errno = 0;
   const double v = std::strtod(text.c_str(), &end);
   if (end == text.c_str() || *end != '\0' || errno != 0 || !std::isfinite(v) || v < lo || v > hi) {
-    throw InputError(option + ": expected a number in [" + std::to_string(lo) + ", " +
-                     std::to_string(hi) + "], got '" + text + "'");
+    throw InputError(option + ": expected a number in [" + io::format_number(lo) + ", " +
+                     io::format_number(hi) + "], got '" + text + "'");
   }
   return v;
 }
@@ -69,19 +70,19 @@ std::filesystem::path drill_scenario(const std::string& drill) {
 }
 
 TrainerOptions parse_options(const std::vector<std::string>& raw) {
-  const cli::Args a =
-      cli::parse_args("phaco-trainer", raw,
-                      {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee",
-                       "--db", "--size", "--threads", "--cache-dir", "--screenshot", "--after",
-                       "--stats", "--stats-after", "--duration", "--timeout"},
-                      {"--stereo", "--no-guidance", "--no-ui", "--no-render"});
+  const cli::Args a = cli::parse_args(
+      "command line", raw,
+      {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee", "--db", "--size",
+       "--threads", "--cache-dir", "--screenshot", "--after", "--stats", "--stats-after",
+       "--duration", "--timeout"},
+      {"--stereo", "--no-guidance", "--no-ui", "--no-render"}, "phaco-trainer --help");
   if (!a.positional.empty()) {
-    throw InputError("phaco-trainer: unexpected argument '" + a.positional[0] +
+    throw InputError("unexpected argument '" + a.positional[0] +
                      "' (give a scenario with --scenario)");
   }
   TrainerOptions o;
   if (a.option("--drill") && a.option("--scenario")) {
-    throw InputError("phaco-trainer: give --drill or --scenario, not both");
+    throw InputError("give --drill or --scenario, not both");
   }
   o.scenario = a.option("--scenario")
                    ? std::filesystem::path(*a.option("--scenario"))
@@ -111,7 +112,7 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   o.ui = !a.flag("--no-ui") && !o.screenshot;  // a screenshot shows the view alone
   o.render = !a.flag("--no-render");
   if (!o.render && !o.stats) throw InputError("--no-render: only with --stats (the baseline)");
-  if (o.screenshot && o.stats) throw InputError("phaco-trainer: --screenshot or --stats, not both");
+  if (o.screenshot && o.stats) throw InputError("--screenshot or --stats, not both");
   if (a.option("--after") && !o.screenshot) throw InputError("--after: only with --screenshot");
   if (a.option("--stats-after") && !o.stats) throw InputError("--stats-after: only with --stats");
   return o;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engine/core/math.hpp"
+#include "engine/io/track.hpp"
 
 namespace phaco {
 
@@ -36,6 +37,15 @@ struct DeviceSample {
   double pedal = 0;              // 0..3 phaco foot pedal
   uint32_t buttons = 0;          // bit i = button i pressed
 };
+
+// A new sample at `t_ns` holding a tool pose (no buttons): what devices that compute poses (a
+// scripted track, the desktop's mouse and gamepad) hand to the loop.
+inline DeviceSample sample_of(const ToolPose& p, int64_t t_ns, uint32_t seq) {
+  DeviceSample s;
+  s.t_ns = t_ns, s.seq = seq;
+  s.pos_mm = p.pos, s.quat = p.quat, s.grip = p.grip, s.pedal = p.pedal;
+  return s;
+}
 
 enum class DeviceHealth : uint8_t {
   Ok = 0,

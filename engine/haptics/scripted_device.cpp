@@ -24,13 +24,7 @@ void ScriptedDevice::start(int64_t now_ns) {
 bool ScriptedDevice::read(int64_t now_ns, DeviceSample& out) {
   if (!started_) return false;
   const ToolPose p = sample_track(track_.track, static_cast<double>(now_ns - start_ns_) * 1e-9);
-  out.t_ns = now_ns;
-  out.seq = ++seq_;
-  out.pos_mm = p.pos;
-  out.quat = p.quat;
-  out.grip = p.grip;
-  out.pedal = p.pedal;
-  out.buttons = 0;
+  out = sample_of(p, now_ns, ++seq_);
   accepted_.fetch_add(1, std::memory_order_relaxed);  // relaxed: a statistic only
   return true;
 }

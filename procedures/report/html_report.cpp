@@ -2,9 +2,9 @@
 
 #include "engine/core/markup.hpp"
 
-// Two passes: read() checks and copies every field the page uses into plain structs (so a wrong
-// type is reported before anything is drawn, with the field's JSON path), then the sections are
-// written from those structs. A missing field is never an error: its section says it is left out.
+// Two passes: read_run (report_fields.hpp) checks and copies every field the page uses into plain
+// structs, then the sections below are written from those structs. A missing field is never an
+// error: its section says it is left out.
 
 #include <algorithm>
 #include <array>
@@ -18,6 +18,7 @@
 
 #include "engine/core/error.hpp"
 #include "perf/chart.hpp"
+#include "procedures/report/report_fields.hpp"
 
 namespace phaco::report {
 
@@ -27,269 +28,13 @@ using nlohmann::json;
 using perf::Chart;
 using perf::Series;
 using perf::Style;
-
-// ---------------------------------------------------------------------------------------------
-// Reading, with the field's path in every message.
-
-[[noreturn]] void bad(const std::string& path, const std::string& what) {
-  throw InputError(path + ": " + what);
-}
-
-std::string join(const std::string& path, const std::string& key) {
-  return path.empty() ? key : path + "." + key;
-}
-
-const json* member(const json& object, const char* key) {
-  const auto it = object.find(key);
-  return it == object.end() ? nullptr : &*it;
-}
-
-void require_object(const json& j, const std::string& path) {
-  if (!j.is_object()) bad(path, "expected an object");
-}
-
-double number(const json& j, const std::string& path) {
-  if (!j.is_number()) bad(path, "expected a number");
-  return j.get<double>();
-}
-
-std::string text(const json& j, const std::string& path) {
-  if (!j.is_string()) bad(path, "expected a string");
-  return j.get<std::string>();
-}
-
-std::vector<double> numbers(const json& j, const std::string& path) {
-  if (!j.is_array()) bad(path, "expected an array of numbers");
-  std::vector<double> v;
-  v.reserve(j.size());
-  for (const json& e : j) {
-    if (!e.is_number()) bad(path, "expected an array of numbers");
-    v.push_back(e.get<double>());
-  }
-  return v;
-}
-
-template <size_t N>
-std::vector<std::array<double, N>> points(const json& j, const std::string& path,
-                                          const char* shape) {
-  const std::string expected = std::string("expected an array of ") + shape + " points";
-  if (!j.is_array()) bad(path, expected);
-  std::vector<std::array<double, N>> v;
-  v.reserve(j.size());
-  for (size_t i = 0; i < j.size(); ++i) {
-    const json& p = j[i];
-    if (!p.is_array() || p.size() != N) bad(path + "[" + std::to_string(i) + "]", expected);
-    std::array<double, N> a{};
-    for (size_t k = 0; k < N; ++k) {
-      if (!p[k].is_number()) bad(path + "[" + std::to_string(i) + "]", expected);
-      a[k] = p[k].get<double>();
-    }
-    v.push_back(a);
-  }
-  return v;
-}
-
-struct Band {
-  std::optional<double> min, max;
-};
-
-struct Term {
-  std::string metric;
-  json value, target;
-  std::optional<double> weight, points;
-};
-
-struct Event {
-  std::optional<double> t_s;
-  std::string kind, hand;
-  std::vector<std::pair<std::string, std::string>> details;
-};
-
-struct Hand {
-  std::string name, tool;
-  std::optional<std::vector<std::array<double, 3>>> pos;  // mm
-  std::optional<std::vector<double>> speed;               // mm/s
-  std::optional<std::vector<double>> force;               // mN
-};
-
-struct Rhexis {
-  std::vector<std::array<double, 2>> outline;                           // mm
-  std::optional<std::array<double, 2>> target_diameter, target_centre;  // mm
-};
-
-struct Trench {
-  std::vector<std::array<double, 3>> removed;  // x mm, y mm, depth fraction
-  std::optional<double> nucleus_radius;        // mm
-};
-
-struct Run {
-  std::string drill, scenario, date, state_hash;
-  std::optional<double> sim_time_s, frames;
-  bool has_metrics = false;
-  std::vector<std::pair<std::string, json>> metrics;  // in the file's (sorted) order
-  std::optional<double> score;
-  bool has_targets = false;
-  std::map<std::string, Band> targets;
-  bool has_terms = false;
-  std::vector<Term> terms;
-  bool has_events = false;
-  std::vector<Event> events;
-  bool has_series = false;
-  std::optional<std::vector<double>> t_s;
-  std::vector<Hand> hands;  // left, right, then any other, in that order
-  std::optional<Rhexis> rhexis;
-  std::optional<Trench> trench;
-};
-
-std::string scalar_text(const json& j);
-
-std::array<double, 2> pair_of(const json& j, const std::string& path) {
-  const std::vector<double> v = numbers(j, path);
-  if (v.size() != 2) bad(path, "expected two numbers");
-  return {v[0], v[1]};
-}
-
-Hand read_hand(const json& j, const std::string& name, const std::string& path) {
-  require_object(j, path);
-  Hand h;
-  h.name = name;
-  if (const json* t = member(j, "tool")) h.tool = text(*t, join(path, "tool"));
-  if (const json* p = member(j, "pos_mm")) h.pos = points<3>(*p, join(path, "pos_mm"), "[x, y, z]");
-  if (const json* s = member(j, "speed_mm_s")) h.speed = numbers(*s, join(path, "speed_mm_s"));
-  if (const json* f = member(j, "force_mN")) h.force = numbers(*f, join(path, "force_mN"));
-  return h;
-}
-
-Run read(const json& j) {
-  if (!j.is_object()) bad("(top level)", "expected a JSON object (a run report)");
-  Run r;
-  if (const json* v = member(j, "drill")) r.drill = text(*v, "drill");
-  if (const json* v = member(j, "scenario")) r.scenario = text(*v, "scenario");
-  if (const json* v = member(j, "date")) r.date = text(*v, "date");
-  if (const json* v = member(j, "state_hash"))
-    r.state_hash = v->is_string() ? v->get<std::string>() : v->dump();
-  if (const json* v = member(j, "sim_time_s")) r.sim_time_s = number(*v, "sim_time_s");
-  if (const json* v = member(j, "frames")) r.frames = number(*v, "frames");
-
-  if (const json* m = member(j, "metrics")) {
-    require_object(*m, "metrics");
-    r.has_metrics = true;
-    for (const auto& [k, v] : m->items()) r.metrics.emplace_back(k, v);
-    if (const json* s = member(*m, "score")) r.score = number(*s, "metrics.score");
-  }
-  if (const json* t = member(j, "targets")) {
-    require_object(*t, "targets");
-    r.has_targets = true;
-    for (const auto& [k, v] : t->items()) {
-      const std::string path = join("targets", k);
-      if (!v.is_object()) bad(path, "expected an object {\"min\": a, \"max\": b}");
-      Band b;
-      if (const json* lo = member(v, "min")) b.min = number(*lo, join(path, "min"));
-      if (const json* hi = member(v, "max")) b.max = number(*hi, join(path, "max"));
-      r.targets[k] = b;
-    }
-  }
-  if (const json* s = member(j, "score_terms")) {
-    if (!s->is_array()) bad("score_terms", "expected an array of terms");
-    r.has_terms = true;
-    for (size_t i = 0; i < s->size(); ++i) {
-      const json& e = (*s)[i];
-      const std::string path = "score_terms[" + std::to_string(i) + "]";
-      require_object(e, path);
-      Term t;
-      if (const json* v = member(e, "metric")) t.metric = text(*v, join(path, "metric"));
-      if (const json* v = member(e, "value")) t.value = *v;
-      if (const json* v = member(e, "target")) t.target = *v;
-      if (const json* v = member(e, "weight")) t.weight = number(*v, join(path, "weight"));
-      if (const json* v = member(e, "points")) t.points = number(*v, join(path, "points"));
-      r.terms.push_back(std::move(t));
-    }
-  }
-  if (const json* ev = member(j, "events")) {
-    if (!ev->is_array()) bad("events", "expected an array of events");
-    r.has_events = true;
-    for (size_t i = 0; i < ev->size(); ++i) {
-      const json& e = (*ev)[i];
-      const std::string path = "events[" + std::to_string(i) + "]";
-      require_object(e, path);
-      Event out;
-      for (const auto& [k, v] : e.items()) {
-        if (k == "t_s")
-          out.t_s = number(v, join(path, k));
-        else if (k == "kind")
-          out.kind = text(v, join(path, k));
-        else if (k == "hand")
-          out.hand = text(v, join(path, k));
-        else
-          out.details.emplace_back(k, scalar_text(v));
-      }
-      r.events.push_back(std::move(out));
-    }
-  }
-  if (const json* s = member(j, "series")) {
-    require_object(*s, "series");
-    r.has_series = true;
-    if (const json* t = member(*s, "t_s")) r.t_s = numbers(*t, "series.t_s");
-    if (const json* hs = member(*s, "hands")) {
-      require_object(*hs, "series.hands");
-      for (const char* name : {"left", "right"}) {
-        if (const json* h = member(*hs, name))
-          r.hands.push_back(read_hand(*h, name, join("series.hands", name)));
-      }
-      for (const auto& [k, v] : hs->items()) {
-        if (k != "left" && k != "right")
-          r.hands.push_back(read_hand(v, k, join("series.hands", k)));
-      }
-    }
-    if (const json* rx = member(*s, "rhexis")) {
-      require_object(*rx, "series.rhexis");
-      Rhexis out;
-      if (const json* o = member(*rx, "outline_mm"))
-        out.outline = points<2>(*o, "series.rhexis.outline_mm", "[x, y]");
-      if (const json* d = member(*rx, "target_diameter_mm"))
-        out.target_diameter = pair_of(*d, "series.rhexis.target_diameter_mm");
-      if (const json* c = member(*rx, "target_centre_mm"))
-        out.target_centre = pair_of(*c, "series.rhexis.target_centre_mm");
-      r.rhexis = std::move(out);
-    }
-    if (const json* tr = member(*s, "trench")) {
-      require_object(*tr, "series.trench");
-      Trench out;
-      if (const json* p = member(*tr, "removed_xy_depth"))
-        out.removed = points<3>(*p, "series.trench.removed_xy_depth", "[x, y, depth_fraction]");
-      if (const json* n = member(*tr, "nucleus_radius_mm"))
-        out.nucleus_radius = number(*n, "series.trench.nucleus_radius_mm");
-      r.trench = std::move(out);
-    }
-  }
-  return r;
-}
+using namespace fields;  // the report's fields, read and checked (report_fields.hpp)
 
 // ---------------------------------------------------------------------------------------------
 // Writing.
 
 std::string escape(const std::string& s) {
   return escape_markup(s);
-}
-
-std::string fmt(double v) {
-  if (!std::isfinite(v)) return "n/a";
-  char buf[48];
-  if (v == std::round(v) && std::fabs(v) < 1e12)
-    std::snprintf(buf, sizeof buf, "%.0f", v);
-  else
-    std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
-
-std::string scalar_text(const json& j) {
-  if (j.is_number()) return fmt(j.get<double>());
-  if (j.is_boolean()) return j.get<bool>() ? "yes" : "no";
-  if (j.is_string()) return j.get<std::string>();
-  if (j.is_null()) return "—";
-  std::string s = j.dump();
-  if (s.size() > 80) s = s.substr(0, 77) + "...";
-  return s;
 }
 
 std::optional<double> as_number(const json& j) {
@@ -836,7 +581,7 @@ std::string base64_encode(std::span<const std::uint8_t> bytes) {
 }
 
 std::string html_report(const json& run, const std::string& extra_sections) {
-  const Run r = read(run);
+  const Run r = read_run(run);
   std::string title = "OpenPhaco report";
   if (!r.drill.empty()) title += " — " + r.drill;
   std::string page =

@@ -201,13 +201,7 @@ bool DesktopDevice::read(int64_t now_ns, DeviceSample& out) {
   if (!started_.load(std::memory_order_relaxed)) return false;
   ToolPose p;
   input_->read_pose(hand_, p);
-  out.t_ns = now_ns;
-  out.seq = ++seq_;
-  out.pos_mm = p.pos;
-  out.quat = p.quat;
-  out.grip = p.grip;
-  out.pedal = p.pedal;
-  out.buttons = 0;
+  out = sample_of(p, now_ns, ++seq_);
   accepted_.fetch_add(1, std::memory_order_relaxed);
   return true;
 }

@@ -29,9 +29,15 @@ bool is_trackless(const std::string& spec) {
 
 TrainerSession::TrainerSession(TrainerConfig config)
     : config_(std::move(config)), desktop_(std::make_shared<DesktopInput>(config_.desktop)) {
-  for (const std::string& spec : config_.devices) {
+  for (size_t h = 0; h < config_.devices.size(); ++h) {
+    const std::string& spec = config_.devices[h];
     if (spec == "desktop" || is_trackless(spec)) continue;
-    parse_device_spec(spec);  // throws InputError naming the spec
+    try {
+      parse_device_spec(spec);
+    } catch (const InputError& e) {  // which hand, and the trainer's own choices too
+      throw InputError(std::string(to_string(static_cast<Hand>(h))) + " hand: " + e.what() +
+                       " (or desktop, track)");
+    }
   }
   if (config_.duration_s < 0 || !std::isfinite(config_.duration_s))
     throw InputError("trainer: duration must be ≥ 0 s");
