@@ -10,6 +10,8 @@
 //   phaco-perf haptics      issue 6: the 1 kHz haptic thread beside the scene, the local model
 //   phaco-perf drills       issue 7: expert and novice drills, difficulty levels, comparisons
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
+//   phaco-perf sweep        issue 9: every drill at every level, thread count and method alternative,
+//                           with the haptic thread beside it; the targets; the checks CI runs
 //   phaco-perf all          every study above, in that order
 //
 // Every study takes --quick (small levels, few steps, about a minute) and --out-dir DIR (default
@@ -22,6 +24,7 @@
 
 #include "engine/core/error.hpp"
 #include "perf/studies.hpp"
+#include "perf/sweep/sweep_point.hpp"
 
 namespace {
 
@@ -76,8 +79,20 @@ studies:
       Issue 8, phaco-trainer under Xvfb on Mesa's software renderer at 1280x720, each drill with
       scripted hands: render frame rate and frame times, simulation rate and haptic period, with
       and without rendering. About 2 minutes (quick 30 s). Needs xvfb-run.
+  sweep [--max-level L] [--drill NAME]...
+      Issue 9, the whole trainer under load: each drill's scripted expert run to its end at every
+      resolution level 0..L (default 8: 256k capsule vertices, 1.6M lens tets; quick 0..3), on 1
+      and 2 threads, each point in a process of its own with the 1 kHz haptic thread beside it;
+      and each method alternative of the scene (integrators, stiffness, layout, active set, spring
+      law; broadphase, narrowphase, lens model) at levels 1, 3, 5 (quick 1). Records frame and
+      per-system p50/p99/max, haptic period and overruns, memory and bytes per element, accuracy
+      against the finest level, state hashes; charts frame cost against mesh size (seeds' figures
+      as reference points), stacked system cost, speed against accuracy, thread scaling, haptic
+      period histograms, memory; judges the issue's targets. Checks (exit status 1 if any fails):
+      every point runs to its end, 1 and 2 threads give the same state hash, the default methods
+      never diverge and stay within their accuracy bounds. About 10 minutes (quick about 1).
   all
-      foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer.
+      foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer, sweep.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -87,13 +102,17 @@ DIR/RESULTS.md (DIR defaults to the source tree's perf/).
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
+  // One sweep point in a process of its own (perf/sweep/sweep_point.hpp); not for users.
+  if (!args.empty() && args[0] == "_sweep-point")
+    return perf::sweep_point_main({args.begin() + 1, args.end()});
+  bool regenerated = false;
+  perf::StudyOptions options;
   try {
     if (args.empty() || args[0] == "--help" || args[0] == "-h") {
       std::fputs(kUsage, args.empty() ? stderr : stdout);
       return args.empty() ? 2 : 0;
     }
     const std::string cmd = args[0];
-    perf::StudyOptions options;
     options.out_dir = fs::path(PHACO_SOURCE_DIR) / "perf";
     for (size_t i = 1; i < args.size(); ++i) {
       if (args[i] == "--quick") {
@@ -122,6 +141,8 @@ int main(int argc, char** argv) {
       perf::run_drills(options);
     } else if (cmd == "trainer") {
       perf::run_trainer_study(options);
+    } else if (cmd == "sweep") {
+      perf::run_sweep(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");
@@ -133,13 +154,20 @@ int main(int argc, char** argv) {
       perf::run_haptics(options);
       perf::run_drills(options);
       perf::run_trainer_study(options);
+      perf::run_sweep(options);
     } else {
       std::fprintf(stderr, "phaco-perf: unknown study '%s' (try --help)\n", cmd.c_str());
       return 2;
     }
+    regenerated = true;
     perf::regenerate_results(options.out_dir);
     std::printf("wrote %s\n", (options.out_dir / "RESULTS.md").c_str());
     return 0;
+  } catch (const perf::CheckFailed& e) {
+    // The figures were written: keep them in RESULTS.md, then fail.
+    if (!regenerated) perf::regenerate_results(options.out_dir);
+    std::fprintf(stderr, "phaco-perf: check failed: %s\n", e.what());
+    return 1;
   } catch (const InputError& e) {
     std::fprintf(stderr, "phaco-perf: %s\n", e.what());
     return 2;

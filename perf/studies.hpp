@@ -3,6 +3,7 @@
 // perf/results/<study>_*.png and its markdown section perf/results/<study>.md, then RESULTS.md is
 // reassembled from every section present (perf/report.hpp).
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,13 @@ void run_lens(const StudyOptions& options);
 void run_haptics(const StudyOptions& options);
 void run_drills(const StudyOptions& options);
 void run_trainer_study(const StudyOptions& options);
+void run_sweep(const StudyOptions& options);
+
+// A study's own checks failed (e.g. the sweep's accuracy bounds): the figures are still written,
+// and phaco-perf exits 1 naming what failed.
+struct CheckFailed : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 // Rewrites out_dir/RESULTS.md from the machine description and the sections in out_dir/results.
 void regenerate_results(const std::filesystem::path& out_dir);

@@ -79,7 +79,7 @@ SceneRow measure_scene(const Scenario& scenario, int threads, int repeats, const
 
 void foundation(const StudyOptions& options) {
   const std::vector<std::string>& args = options.extra;
-  int max_level = options.quick ? 3 : eye::kMaxLevel, repeats = options.quick ? 1 : 3;
+  int max_level = options.quick ? 3 : 7, repeats = options.quick ? 1 : 3;
   const fs::path out_dir = options.out_dir;
   fs::path scenario_file = fs::path(PHACO_SOURCE_DIR) / "data/scenarios/empty_scene.json";
   for (size_t i = 0; i < args.size(); ++i) {
@@ -89,7 +89,7 @@ void foundation(const StudyOptions& options) {
     };
     if (args[i] == "--max-level") {
       max_level = std::stoi(value());
-      if (max_level < eye::kMinLevel || max_level > eye::kMaxLevel) throw InputError("foundation: --max-level out of 0..7");
+      if (max_level < eye::kMinLevel || max_level > eye::kMaxLevel) throw InputError("foundation: --max-level out of 0.." + std::to_string(eye::kMaxLevel));
     } else if (args[i] == "--frames-repeat") {
       repeats = std::max(1, std::stoi(value()));
     } else if (args[i] == "--scenario") {

@@ -15,6 +15,11 @@ PHACO_BUILD_DIR="$build" "$root/scripts/build.sh"
 # Tests build their meshes into a cache inside the build tree, never into the user's home.
 export PHACO_CACHE_DIR="$build/mesh-cache"
 ctest --test-dir "$build" --output-on-failure -j "$jobs"
+# The perf harness's quick sweep (issue 9): every drill at levels 0..3 and each method alternative,
+# each point in its own process. It fails the run if a point does not run to its end, if 1 and 2
+# threads give different state hashes, or if the default methods diverge or leave their accuracy
+# bounds. Speed is reported (in build/release/perf-quick/RESULTS.md), never checked here.
+"$build/perf/phaco-perf" sweep --quick --out-dir "$build/perf-quick"
 
 if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   asan="$root/build/asan"

@@ -40,7 +40,7 @@ usage:
   phaco validate FILE...
       Check scenario files; every problem is named by file, JSON path and what was expected.
   phaco mesh --level L --out DIR [--layout curvilinear|isotropic] [--no-tets] [--params FILE]
-      Generate the standard eye's meshes at resolution level L (0..7, default eye level 3:
+      Generate the standard eye's meshes at resolution level L (0..8, default eye level 3:
       about 8k capsule vertices, 50k lens tets) as OBJ and TetGen .node/.ele files.
   phaco report RUN.json --html OUT.html [--expert EXPERT.json]
       Write a run report (phaco run --report) as one self-contained HTML page: the score and its

@@ -79,6 +79,8 @@ class HapticLoop {
   const LoopSettings& settings() const { return settings_; }
   // Any thread, also while running (approximate then; see loop_stats.hpp).
   LoopStatsSnapshot stats() const { return stats_.snapshot(); }
+  // The period's histogram bins (charts of the period under load).
+  std::vector<DurationHistogram::Bin> period_bins() const { return stats_.period().occupied_bins(); }
 
  private:
   void run();

@@ -97,6 +97,15 @@ DurationSummary DurationHistogram::summary() const {
   return s;
 }
 
+std::vector<DurationHistogram::Bin> DurationHistogram::occupied_bins() const {
+  std::vector<Bin> out;
+  for (int64_t i = 0; i < kBins; ++i) {
+    const uint64_t n = bins_[i].load(std::memory_order_relaxed);
+    if (n > 0) out.push_back({bin_low_us(i), bin_width_us(i), n});
+  }
+  return out;
+}
+
 void LoopStats::record_tick(int64_t period_ns, int64_t lateness_ns, int64_t compute_ns) {
   if (period_ns >= 0) period_.record(period_ns);
   lateness_.record(lateness_ns);

@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace phaco {
 
@@ -57,6 +58,12 @@ class DurationHistogram {
   void reset();
   // Any thread.
   DurationSummary summary() const;
+  // The occupied bins as (low edge µs, width µs, count), in order: for histogram charts.
+  struct Bin {
+    int64_t low_us = 0, width_us = 1;
+    uint64_t count = 0;
+  };
+  std::vector<Bin> occupied_bins() const;
 
   // Bin arithmetic, exposed for tests.
   static int64_t bin_of(int64_t us);
@@ -80,6 +87,7 @@ class LoopStats {
   void record_overrun(int64_t missed);
   void reset();  // not while recording
   LoopStatsSnapshot snapshot() const;
+  const DurationHistogram& period() const { return period_; }
 
  private:
   DurationHistogram period_, lateness_, compute_;

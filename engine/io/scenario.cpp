@@ -33,7 +33,7 @@ constexpr std::array<std::string_view, 2> kCapsuleLayouts{"curvilinear", "isotro
 constexpr std::array<std::string_view, 5> kMeshBodies{"cornea", "capsule", "iris", "globe",
                                                       "lens_surface"};
 
-constexpr int kMaxLevel = 7;
+constexpr int kMaxLevel = 8;
 constexpr double kMaxDt = 0.1;           // s; coarser steps cannot resolve tool contact
 constexpr double kMaxDuration = 3600.0;  // s
 constexpr double kMaxGrip = 1.0;

@@ -46,7 +46,7 @@ struct HandTrack {
 };
 
 struct EyeSpec {
-  int level = 3;                               // mesh resolution level 0..7
+  int level = 3;                               // mesh resolution level 0..8
   std::string capsule_layout = "curvilinear";  // or "isotropic"
   std::map<std::string, double> overrides;     // "section.key" -> value, checked by the eye model
   std::optional<std::filesystem::path> params_file;     // resolved, absolute

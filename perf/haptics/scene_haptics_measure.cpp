@@ -20,6 +20,7 @@
 #include "procedures/haptics/realtime_run.hpp"
 // The haptic-thread allocation counter the tests use (global operator new, per marked thread);
 // linked into phaco-perf so the harness reports the same count.
+#include "perf/haptics/counting_device.hpp"
 #include "tests/engine/haptics/alloc_counter.hpp"
 
 namespace phaco::perf {
@@ -29,34 +30,6 @@ Scenario demo() {
   return load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) /
                        "data/scenarios/capsulorhexis_demo.json");
 }
-
-// Wraps a device: the first read after `arm()` marks the calling thread (the haptic thread) so its
-// allocations from then on are counted. Everything else is passed through.
-class CountingDevice final : public Device {
- public:
-  explicit CountingDevice(std::unique_ptr<Device> inner) : inner_(std::move(inner)) {}
-  std::string_view name() const override { return inner_->name(); }
-  DeviceLimits limits() const override { return inner_->limits(); }
-  void start(int64_t now) override { inner_->start(now); }
-  void stop() override { inner_->stop(); }
-  bool read(int64_t now, DeviceSample& out) override {
-    if (armed_.load(std::memory_order_relaxed)) {
-      test::count_allocations_on_this_thread(true);
-      armed_.store(false, std::memory_order_relaxed);
-      marked_.store(true, std::memory_order_release);
-    }
-    return inner_->read(now, out);
-  }
-  void write_force(const Vec3& f, int64_t now) override { inner_->write_force(f, now); }
-  DeviceHealth health(int64_t now) const override { return inner_->health(now); }
-  DeviceCounters counters() const override { return inner_->counters(); }
-  void arm() { armed_.store(true, std::memory_order_relaxed); }
-  bool marked() const { return marked_.load(std::memory_order_acquire); }
-
- private:
-  std::unique_ptr<Device> inner_;
-  std::atomic<bool> armed_{false}, marked_{false};
-};
 
 // Sum of the "steal" column over all cores (/proc/stat first line), in ms; −1 where unreadable.
 double steal_ms() {

@@ -5,7 +5,7 @@
 namespace phaco::eye {
 
 constexpr int kMinLevel = 0;
-constexpr int kMaxLevel = 7;
+constexpr int kMaxLevel = 8;
 constexpr int kDefaultLevel = 3;
 
 // Targets the generators meet within about ±25 %.

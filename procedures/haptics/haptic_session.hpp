@@ -79,6 +79,8 @@ class HapticSession final : public HapticPort {
   bool running() const { return loop_.running(); }
 
   HapticSessionStats stats() const;
+  // The 1 kHz thread's period histogram (occupied bins), for the harness's charts.
+  std::vector<DurationHistogram::Bin> period_bins() const { return loop_.period_bins(); }
 
   // HapticPort (simulation thread).
   bool newest_pose(Hand hand, ToolPose& pose) override;

@@ -90,6 +90,27 @@ TEST(DurationHistogram, SmallSetsAndReset) {
   expect_close_to_reference((h.record(5'000), h.record(7'000), h.summary()), {5'000, 7'000});
 }
 
+TEST(DurationHistogram, OccupiedBinsHoldEverySampleInOrder) {
+  H h;
+  EXPECT_TRUE(h.occupied_bins().empty());
+  for (int64_t ns : {999'400, 999'900, 1'000'200, 1'000'700, 1'000'700, 3'000'000}) h.record(ns);
+  const auto bins = h.occupied_bins();
+  ASSERT_EQ(bins.size(), 3u);  // 1 µs bins 999 and 1000, then a 32 µs bin holding 3000
+  uint64_t total = 0;
+  for (size_t i = 0; i < bins.size(); ++i) {
+    total += bins[i].count;
+    if (i > 0) EXPECT_GE(bins[i].low_us, bins[i - 1].low_us + bins[i - 1].width_us);
+  }
+  EXPECT_EQ(total, 6u);
+  EXPECT_EQ(bins[0].low_us, 999);
+  EXPECT_EQ(bins[0].count, 2u);
+  EXPECT_EQ(bins[1].low_us, 1000);
+  EXPECT_EQ(bins[1].count, 3u);
+  EXPECT_EQ(bins[2].count, 1u);
+  EXPECT_LE(bins[2].low_us, 3000);
+  EXPECT_GT(bins[2].low_us + bins[2].width_us, 3000);
+}
+
 TEST(LoopStats, CountsTicksOverrunsAndMissedDeadlines) {
   LoopStats stats;
   stats.record_tick(-1, 20'000, 50'000);  // first tick: no period

@@ -252,10 +252,10 @@ const std::vector<BadCase> kBadCases = {
      {"bool_for_number.json: hands.right.track[1].grip: expected a number, got boolean true"}},
     {"name_not_string.json", {"name_not_string.json: name: expected a string, got 42"}},
     {"negative_level.json",
-     {"negative_level.json: eye.level: expected an integer in 0..7, got -1"}},
-    {"level_9.json", {"level_9.json: eye.level: expected an integer in 0..7, got 9"}},
+     {"negative_level.json: eye.level: expected an integer in 0..8, got -1"}},
+    {"level_9.json", {"level_9.json: eye.level: expected an integer in 0..8, got 9"}},
     {"level_not_integer.json",
-     {"level_not_integer.json: eye.level: expected an integer in 0..7, got 2.5"}},
+     {"level_not_integer.json: eye.level: expected an integer in 0..8, got 2.5"}},
     {"unknown_capsule_layout.json",
      {"unknown_capsule_layout.json: eye.capsule_layout: unknown capsule layout 'radial'; expected "
       "one of: curvilinear, isotropic"}},

@@ -150,7 +150,8 @@ TEST(Resolution, LevelsDoubleAndBoundsAreChecked) {
               2 * resolution_for_level(l - 1).capsule_vertices);
   }
   EXPECT_THROW(resolution_for_level(-1), InputError);
-  EXPECT_THROW(resolution_for_level(8), InputError);
+  EXPECT_THROW(resolution_for_level(kMaxLevel + 1), InputError);
+  EXPECT_EQ(kMaxLevel, 8);  // level 8: 256k capsule vertices, 1.6M lens tets (issue 9)
 }
 
 }  // namespace

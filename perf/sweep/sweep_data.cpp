@@ -1,0 +1,74 @@
+#include "perf/sweep/sweep_data.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "perf/report.hpp"
+
+namespace phaco::perf {
+
+namespace {
+
+double element(const SweepPointResult& r, const std::string& key) {
+  const auto it = r.elements.find(key);
+  return it == r.elements.end() ? 0.0 : double(it->second);
+}
+
+double metric(const SweepPointResult& r, const std::string& name) {
+  const auto it = r.metrics.find(name);
+  return it != r.metrics.end() && it->is_number() ? it->get<double>()
+                                                  : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+const char* drill_elements_name(const std::string& drill) {
+  if (drill == "capsulorhexis") return "capsule vertices";
+  if (drill == "phaco_sculpting") return "lens tets";
+  return "cornea vertices";
+}
+
+double drill_elements(const SweepPointResult& r) {
+  const std::string& d = r.config.drill;
+  if (d == "capsulorhexis") return element(r, "capsule.particles");
+  if (d == "phaco_sculpting") {
+    // Tets left at the end plus those the probe removed: the lens as the drill began.
+    const double removed = metric(r, "tets_removed");
+    return element(r, "lens.tets") + (std::isfinite(removed) ? removed : 0.0);
+  }
+  return element(r, "cornea.particles");
+}
+
+// The outcome a trainee is scored on, one metric per aspect: for the capsulorhexis the opening's
+// size and roundness; for sculpting the volume removed and the trench's width and depth; for the
+// incision its width and tunnel length (docs/metrics.md).
+const std::vector<std::string>& accuracy_metrics(const std::string& drill) {
+  static const std::vector<std::string> rhexis = {"rhexis.diameter_mm", "rhexis.circularity"};
+  static const std::vector<std::string> sculpt = {"volume_removed_mm3", "trench.width_mm",
+                                                  "trench.depth_fraction"};
+  static const std::vector<std::string> incision = {"incision.width_mm",
+                                                    "incision.tunnel_length_mm"};
+  if (drill == "capsulorhexis") return rhexis;
+  if (drill == "phaco_sculpting") return sculpt;
+  return incision;
+}
+
+double accuracy_error_pct(const SweepPointResult& r, const SweepPointResult& reference,
+                          std::string* detail) {
+  double worst = 0;
+  for (const std::string& name : accuracy_metrics(r.config.drill)) {
+    const double m = metric(r, name), ref = metric(reference, name);
+    if (!std::isfinite(m) || !std::isfinite(ref) || ref == 0) {
+      if (detail) *detail = name + " missing";
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    const double e = 100.0 * std::abs(m - ref) / std::abs(ref);
+    if (e >= worst) {
+      worst = e;
+      if (detail) *detail = name + " " + fmt("%.3f", m) + " vs " + fmt("%.3f", ref);
+    }
+  }
+  return worst;
+}
+
+}  // namespace phaco::perf

@@ -1,0 +1,44 @@
+#pragma once
+// The issue-9 sweep's points once measured, and what the study derives from them: each point's
+// element count on the chart's axis, its accuracy error against its drill's reference point, and
+// the checks a --quick run in CI enforces (perf/study_sweep.cpp).
+#include <map>
+#include <string>
+#include <vector>
+
+#include "perf/sweep/sweep_point.hpp"
+
+namespace phaco::perf {
+
+struct SweepRow {
+  SweepPointResult r;
+  double elements =
+      0;  // the drill's own body: capsule vertices, lens tets at the start, cornea vertices
+  double error_pct = 0;  // accuracy against the drill's reference point (NaN: a metric is missing)
+  std::string error_detail;  // which metric is furthest off, e.g. "rhexis.diameter_mm 5.31 vs 5.33"
+};
+
+// The drill's own element count for the charts' x axis.
+double drill_elements(const SweepPointResult& r);
+const char* drill_elements_name(const std::string& drill);
+
+// The metrics a drill's accuracy is judged on, each compared relative to the reference's value.
+const std::vector<std::string>& accuracy_metrics(const std::string& drill);
+
+// 100·max over accuracy_metrics of |m − m_ref| / |m_ref|; NaN when a metric is missing.
+double accuracy_error_pct(const SweepPointResult& r, const SweepPointResult& reference,
+                          std::string* detail = nullptr);
+
+// Frame-cost charts per drill, the per-system stacked cost, speed against accuracy, thread scaling,
+// haptic period histograms and bytes per element: results_dir/sweep_*.png. Returns the file names
+// written, for the markdown.
+struct SweepChartFiles {
+  std::map<std::string, std::string> frame_cost;  // per drill
+  std::map<std::string, std::string> systems;     // per drill
+  std::map<std::string, std::string> pareto;      // per drill with method variants
+  std::string threads, haptics, memory;
+};
+SweepChartFiles draw_sweep_charts(const std::vector<SweepRow>& rows,
+                                  const std::filesystem::path& results_dir);
+
+}  // namespace phaco::perf

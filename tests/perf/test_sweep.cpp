@@ -1,0 +1,137 @@
+// The issue-9 sweep's pieces: a point's result survives the trip through the child process's JSON,
+// the accuracy error is the largest relative difference of the drill's scored outcome, and a point
+// run with the haptic thread beside it is bit-identical to the plain run of the same scenario.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "engine/core/error.hpp"
+#include "perf/sweep/sweep_data.hpp"
+#include "perf/sweep/sweep_point.hpp"
+#include "procedures/scene/run.hpp"
+
+namespace phaco::perf {
+namespace {
+
+namespace fs = std::filesystem;
+
+SweepPointResult with_metrics(const std::string& drill, nlohmann::json metrics) {
+  SweepPointResult r;
+  r.config.drill = drill;
+  r.ok = true;
+  r.metrics = std::move(metrics);
+  return r;
+}
+
+TEST(SweepPoint, ResultRoundTripsThroughJson) {
+  SweepPointResult r = with_metrics("phaco_sculpting", {{"score", 97.5}, {"tets_removed", 12}});
+  r.config.scenario = "/x/phaco_sculpting_expert.json";
+  r.config.level = 5;
+  r.config.threads = 2;
+  r.config.methods = {{"lens.broadphase", "dbvt"}};
+  r.config.variant = "lens.broadphase=dbvt";
+  r.frames = 6840;
+  r.frame = {"frame", 0.1, 0.3, 2.5, 0.12};
+  r.systems = {{"lens_sculpt", 0.05, 0.2, 1.0, 0.06}};
+  r.period_p99_us = 1010.5;
+  r.haptic_allocations = 0;
+  r.period_bins = {{999, 1, 10}, {1000, 1, 900}};
+  r.elements = {{"lens.tets", 100}, {"lens.particles", 40}};
+  r.total_elements = 140;
+  r.bytes_per_element = 180.5;
+  r.state_hash = "0123456789abcdef";
+  const SweepPointResult back = result_from_json(nlohmann::json::parse(to_json(r).dump()));
+  EXPECT_EQ(back.config.variant, r.config.variant);
+  EXPECT_EQ(back.config.methods, r.config.methods);
+  EXPECT_EQ(back.config.level, 5);
+  EXPECT_EQ(back.config.threads, 2);
+  EXPECT_EQ(back.frames, 6840u);
+  EXPECT_DOUBLE_EQ(back.frame.max_ms, 2.5);
+  ASSERT_EQ(back.systems.size(), 1u);
+  EXPECT_EQ(back.systems[0].name, "lens_sculpt");
+  EXPECT_DOUBLE_EQ(back.period_p99_us, 1010.5);
+  EXPECT_EQ(back.period_bins, r.period_bins);
+  EXPECT_EQ(back.elements, r.elements);
+  EXPECT_DOUBLE_EQ(back.bytes_per_element, 180.5);
+  EXPECT_EQ(back.state_hash, r.state_hash);
+  EXPECT_DOUBLE_EQ(drill_elements(back), 112.0);  // tets left plus those the probe removed
+}
+
+TEST(SweepAccuracy, LargestRelativeDifferenceOfTheScoredOutcome) {
+  const auto ref =
+      with_metrics("capsulorhexis", {{"rhexis.diameter_mm", 5.0}, {"rhexis.circularity", 0.95}});
+  const auto run = with_metrics("capsulorhexis",
+                                {{"rhexis.diameter_mm", 4.5}, {"rhexis.circularity", 0.95 * 1.02}});
+  std::string detail;
+  EXPECT_NEAR(accuracy_error_pct(run, ref, &detail), 10.0, 1e-9);
+  EXPECT_NE(detail.find("rhexis.diameter_mm"), std::string::npos);
+  EXPECT_DOUBLE_EQ(accuracy_error_pct(ref, ref), 0.0);
+  // An incomplete rhexis has no diameter: the error is unknown, never 0.
+  const auto open = with_metrics("capsulorhexis", {{"rhexis.circularity", 0.9}});
+  EXPECT_TRUE(std::isnan(accuracy_error_pct(open, ref, &detail)));
+  EXPECT_NE(detail.find("missing"), std::string::npos);
+}
+
+// The haptic thread beside the frames (scripted device, models published each frame) must not
+// change the run: the same state hash as run_scenario's.
+TEST(SweepPoint, TheHapticThreadBesideLeavesTheRunBitIdentical) {
+  const fs::path scenario =
+      fs::path(PHACO_SOURCE_DIR) / "data/scenarios/corneal_incision_expert.json";
+  SweepPointConfig c;
+  c.drill = "corneal_incision";
+  c.scenario = scenario;
+  c.level = 0;
+  c.threads = 2;
+  c.realtime = false;  // a test must not ask for SCHED_FIFO
+  const SweepPointResult r = run_sweep_point(c);
+  ASSERT_TRUE(r.ok) << r.error;
+  Scenario s = load_scenario(scenario);
+  s.eye.level = 0;
+  const RunReport plain = run_scenario(s, SceneOptions{.threads = 1});
+  EXPECT_EQ(r.state_hash, plain.state_hash);
+  EXPECT_EQ(r.frames, plain.frames);
+  EXPECT_LE(r.frame.p50_ms, r.frame.p99_ms);
+  EXPECT_LE(r.frame.p99_ms, r.frame.max_ms);
+  EXPECT_GT(r.total_elements, 0u);
+  EXPECT_GT(r.rss_peak_mb, 0.0);
+  EXPECT_GE(r.rss_peak_mb, r.rss_before_mb);
+  EXPECT_TRUE(r.metrics.contains("incision.width_mm"));
+}
+
+// A point whose process fails or dies is a failed point with the reason, and the sweep goes on.
+TEST(SweepPoint, AChildThatFailsOrCrashesIsReportedNotFatal) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("phaco_sweep_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  SweepPointConfig c;
+  c.drill = "corneal_incision";
+  c.scenario = "/nonexistent/scenario.json";
+  const fs::path fail = dir / "fail.sh", crash = dir / "crash.sh";
+  std::ofstream(fail) << "#!/bin/sh\necho 'no such mesh' >&2\nexit 3\n";
+  std::ofstream(crash) << "#!/bin/sh\nkill -SEGV $$\n";
+  fs::permissions(fail, fs::perms::owner_all);
+  fs::permissions(crash, fs::perms::owner_all);
+  const SweepPointResult failed = run_sweep_point_isolated(c, fail, dir / "a");
+  EXPECT_FALSE(failed.ok);
+  EXPECT_NE(failed.error.find("exited with status 3: no such mesh"), std::string::npos)
+      << failed.error;
+  const SweepPointResult died = run_sweep_point_isolated(c, crash, dir / "b");
+  EXPECT_FALSE(died.ok);
+  EXPECT_NE(died.error.find("signal 11"), std::string::npos) << died.error;
+  // In this process: the bad scenario is an input error naming the file.
+  c.haptics = false;
+  try {
+    run_sweep_point(c);
+    ADD_FAILURE() << "no error for a missing scenario";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scenario.json"), std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace phaco::perf
