@@ -120,7 +120,7 @@ SweepChartFiles draw_sweep_charts(const std::vector<SweepRow>& rows, const fs::p
     std::set<std::string> variants;
     for (const auto& row : rows)
       if (row.r.ok && row.r.config.drill == drill && row.r.config.threads == 1)
-        variants.insert(row.r.config.variant);
+        if (row.r.config.variant != "no haptic thread") variants.insert(row.r.config.variant);
     if (variants.size() > 1) {
       Chart pa{.title = drill + ": speed against accuracy (1 thread)",
                .x = {.label = "mean frame time (ms)", .scale = Scale::Log10},
@@ -157,6 +157,17 @@ SweepChartFiles draw_sweep_charts(const std::vector<SweepRow>& rows, const fs::p
           tx0 = std::min(tx0, a->elements), tx1 = std::max(tx1, a->elements);
         }
     th.series.push_back(s);
+    // The same without the haptic thread beside the frames (default level and the largest).
+    const auto one_alone = select(rows, drill, 1, "no haptic thread"),
+               two_alone = select(rows, drill, 2, "no haptic thread");
+    Series alone{.name = drill + ", no haptic thread", .style = Style::Scatter};
+    for (const auto* a : one_alone)
+      for (const auto* b : two_alone)
+        if (a->r.config.level == b->r.config.level && b->r.frame.mean_ms > 0) {
+          alone.x.push_back(a->elements);
+          alone.y.push_back(a->r.frame.mean_ms / b->r.frame.mean_ms);
+        }
+    th.series.push_back(alone);
   }
   if (tx1 > 0) th.series.push_back(level_line("target 1.7", 1.7, tx0, tx1));
   files.threads = "sweep_threads.png";
