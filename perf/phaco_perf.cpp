@@ -79,7 +79,7 @@ studies:
       Issue 8, phaco-trainer under Xvfb on Mesa's software renderer at 1280x720, each drill with
       scripted hands: render frame rate and frame times, simulation rate and haptic period, with
       and without rendering. About 2 minutes (quick 30 s). Needs xvfb-run.
-  sweep [--max-level L] [--drill NAME]...
+  sweep [--max-level L] [--drill NAME]... [--replot]
       Issue 9, the whole trainer under load: each drill's scripted expert run to its end at every
       resolution level 0..L (default 8: 256k capsule vertices, 1.6M lens tets; quick 0..3), on 1
       and 2 threads, each point in a process of its own with the 1 kHz haptic thread beside it;
@@ -90,7 +90,9 @@ studies:
       as reference points), stacked system cost, speed against accuracy, thread scaling, haptic
       period histograms, memory; judges the issue's targets. Checks (exit status 1 if any fails):
       every point runs to its end, 1 and 2 threads give the same state hash, the default methods
-      never diverge and stay within their accuracy bounds. About 10 minutes (quick about 1).
+      never diverge and stay within their accuracy bounds. About 18 minutes (quick about 1).
+      --replot redraws the section and charts from DIR/results/sweep_points.json without
+      measuring again (the figures stay those of the run that measured them).
   all
       foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer, sweep.
 

@@ -7,7 +7,7 @@
 namespace phaco {
 namespace {
 
-std::string quoted(std::string_view name) {
+std::string quote_name(std::string_view name) {
   std::string q(1, '\'');  // built by appends: GCC 12 warns falsely on "'" + std::string
   q += name;
   q += '\'';
@@ -25,14 +25,14 @@ void check_descriptions(const std::vector<SystemDesc>& systems) {
     if (s.name.empty()) {
       reject("system #" + std::to_string(i) + " (in registration order) has an empty name");
     }
-    if (!s.run) reject("system " + quoted(s.name) + " has no run function");
+    if (!s.run) reject("system " + quote_name(s.name) + " has no run function");
     if (!seen.emplace(s.name, i).second) {
-      reject("two systems are named " + quoted(s.name) + "; system names must be unique");
+      reject("two systems are named " + quote_name(s.name) + "; system names must be unique");
     }
     for (const auto* list : {&s.reads, &s.writes}) {
       for (const std::string& c : *list) {
         if (c.empty()) {
-          reject("system " + quoted(s.name) + " lists an empty component name in its " +
+          reject("system " + quote_name(s.name) + " lists an empty component name in its " +
                  (list == &s.reads ? "reads" : "writes"));
         }
       }
@@ -41,7 +41,7 @@ void check_descriptions(const std::vector<SystemDesc>& systems) {
   for (const SystemDesc& s : systems) {
     for (const std::string& a : s.after) {
       if (!seen.contains(a)) {
-        reject("system " + quoted(s.name) + " runs after " + quoted(a) +
+        reject("system " + quote_name(s.name) + " runs after " + quote_name(a) +
                ", but no system has that name");
       }
     }
