@@ -181,7 +181,8 @@ std::string why_targets_missed(const std::vector<SweepRow>& rows,
     md +=
         "- **Two threads at the default level.** A drill's frame holds little parallel work. The "
         "capsule's step works on a few hundred active nodes, and each CG iteration over them costs "
-        "microseconds, too little to split across threads with profit. The sculpt query touches a few hundred "
+        "microseconds, too little to split across threads with profit. The sculpt query touches a "
+        "few hundred "
         "tets. The other systems are tiny, and they depend on each other through the frame graph. "
         "Without the haptic thread beside them the speed-ups are " +
         alone +
@@ -515,17 +516,13 @@ void run_sweep(const StudyOptions& options) {
                                   {"threads", threads},
                                   {"run_failures", run_failures},
                                   {"points", all}};
-    std::ofstream(dir / "sweep_points.json") << saved.dump(1) << '\n';
+    std::ofstream(dir / "sweep_points.json") << saved.dump() << '\n';  // compact: ~1 MB indented
   }
   const SweepChartFiles charts = draw_sweep_charts(rows, dir);
 
   auto find = [&](const std::string& drill, int level, int th,
-                  const std::string& variant = "default") -> const SweepRow* {
-    for (const auto& row : rows)
-      if (row.r.ok && row.r.config.drill == drill && row.r.config.level == level &&
-          row.r.config.threads == th && row.r.config.variant == variant)
-        return &row;
-    return nullptr;
+                  const std::string& variant = "default") {
+    return find_row(rows, drill, level, th, variant);
   };
 
   // ---- The section.

@@ -108,6 +108,8 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
     hc.loop.lock_memory = false;
     session = std::make_unique<HapticSession>(hc);
     const Hand hand = device_hand(s);
+    if (!s.find_hand(hand))
+      throw InputError(s.source + ": no hand with a track for the haptic device");
     ScriptedDeviceOptions device_options;
     device_options.hold_s = 1e6;  // keep the device alive however long the frames take
     auto counting = std::make_unique<CountingDevice>(
