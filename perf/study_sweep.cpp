@@ -553,10 +553,14 @@ void run_sweep(const StudyOptions& options) {
     md +=
         "Checks passed: every point ran to its end; 1 and 2 threads gave the same state hash at "
         "every level and variant; the default methods never diverged and stayed within their "
-        "accuracy bounds (capsulorhexis " +
-        fmt("%.0f", bound_of("capsulorhexis").max_error_pct) + " %, sculpting " +
-        fmt("%.0f", bound_of("phaco_sculpting").max_error_pct) + " %, incision " +
-        fmt("%.0f", bound_of("corneal_incision").max_error_pct) + " % from level 1 up).\n\n";
+        "accuracy bounds against level " +
+        std::to_string(reference_level) + " (";
+    for (const std::string& drill : drills) {
+      const Bound b = bound_of(drill);
+      md += (drill == drills.front() ? "" : ", ") + drill + " ≤ " + fmt("%.0f", b.max_error_pct) +
+            " % from level " + std::to_string(b.from_level);
+    }
+    md += ").\n\n";
   }
 
   // Targets.
