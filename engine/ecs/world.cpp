@@ -43,4 +43,28 @@ std::vector<Entity> World::entities() const {
   return out;
 }
 
+std::string World::access_name(Entity e, uint32_t type_id) const {
+  if (type_id >= access_.size() || access_[type_id].name.empty()) {
+    return name(e) + ".<component type " + std::to_string(type_id) +
+           " has no access name: World::name_component>";
+  }
+  const ComponentAccess& a = access_[type_id];
+  switch (a.kind) {
+    case AccessKind::Constant:
+      return {};
+    case AccessKind::Global:
+      return a.name;
+    case AccessKind::PerEntity:
+      break;
+  }
+  return (kind(e) == EntityKind::Tool ? std::string("tools") : name(e)) + "." + a.name;
+}
+
+void World::report_access(Entity e, uint32_t type_id) const {
+  const AccessScope* scope = detail::current_access_scope;
+  if (!scope) return;
+  const std::string n = access_name(e, type_id);
+  if (!n.empty()) scope->touch(n);
+}
+
 }  // namespace phaco

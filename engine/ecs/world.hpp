@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "engine/core/access_scope.hpp"
 #include "engine/core/handle.hpp"
 #include "engine/core/table.hpp"
 
@@ -20,6 +21,15 @@ namespace phaco {
 using Entity = Handle;
 
 enum class EntityKind : uint8_t { Body, Tool };
+
+// How a component type is named in SystemDesc reads and writes (DESIGN.md §4), for the check of
+// declared access (engine/core/access_scope.hpp):
+//   PerEntity  "<owner>.<name>", owner the body's entity name ("capsule.particles"), or "tools"
+//              for any tool ("tools.pose");
+//   Global     "<name>" whichever entity holds it (a drill's record kept on a body: "metrics");
+//   Constant   set when the scene is built and never written by a system (a tool's kind): reading
+//              it needs no declaration.
+enum class AccessKind : uint8_t { PerEntity, Global, Constant };
 
 namespace detail {
 uint32_t next_component_type_id();
@@ -66,13 +76,13 @@ class World {
     pool.by_entity[i] = std::move(component);
     return *pool.by_entity[i];
   }
+  // Null when e has no C. Inside a system whose access is checked, a found component's access
+  // name must be among the system's reads or writes (std::logic_error otherwise).
   template <class C>
   C* get(Entity e) {
-    auto* pool = find_pool<C>();
-    if (!pool || !alive(e) || e.index >= pool->by_entity.size() || !pool->by_entity[e.index]) {
-      return nullptr;
-    }
-    return &*pool->by_entity[e.index];
+    C* c = lookup<C>(e);
+    if (c && detail::current_access_scope) report_access(e, detail::component_type_id<C>());
+    return c;
   }
   template <class C>
   const C* get(Entity e) const {
@@ -85,9 +95,10 @@ class World {
     if (!c) throw std::logic_error("entity '" + name(e) + "' has no such component");
     return *c;
   }
+  // Whether e has C: structure, not the component's data, so not an access to declare.
   template <class C>
   bool has(Entity e) const {
-    return get<C>(e) != nullptr;
+    return const_cast<World*>(this)->lookup<C>(e) != nullptr;
   }
   template <class C>
   bool remove(Entity e) {
@@ -100,8 +111,25 @@ class World {
     auto* pool = find_pool<C>();
     if (!pool) return;
     for (uint32_t i = 0; i < pool->by_entity.size(); ++i) {
-      if (pool->by_entity[i] && entities_.slots.alive(i)) f(entities_.slots.handle(i), *pool->by_entity[i]);
+      if (!pool->by_entity[i] || !entities_.slots.alive(i)) continue;
+      const Entity e = entities_.slots.handle(i);
+      if (detail::current_access_scope) report_access(e, detail::component_type_id<C>());
+      f(e, *pool->by_entity[i]);
     }
+  }
+
+  // Names C for the check of declared access (AccessKind above). A scene names every component
+  // type its systems look up; a lookup of an unnamed type inside a checked system is an error.
+  template <class C>
+  void name_component(std::string name, AccessKind kind = AccessKind::PerEntity) {
+    const uint32_t id = detail::component_type_id<C>();
+    if (access_.size() <= id) access_.resize(id + 1);
+    access_[id] = ComponentAccess{std::move(name), kind};
+  }
+  // The access name of e's C as SystemDesc lists it; empty for a Constant type.
+  template <class C>
+  std::string access_name(Entity e) const {
+    return access_name(e, detail::component_type_id<C>());
   }
 
  private:
@@ -116,6 +144,21 @@ class World {
     }
   };
 
+  struct ComponentAccess {
+    std::string name;  // empty: not named
+    AccessKind kind = AccessKind::PerEntity;
+  };
+
+  std::string access_name(Entity e, uint32_t type_id) const;
+  void report_access(Entity e, uint32_t type_id) const;
+  template <class C>
+  C* lookup(Entity e) {
+    auto* pool = find_pool<C>();
+    if (!pool || !alive(e) || e.index >= pool->by_entity.size() || !pool->by_entity[e.index]) {
+      return nullptr;
+    }
+    return &*pool->by_entity[e.index];
+  }
   uint32_t checked(Entity e) const {
     if (!alive(e)) throw std::logic_error("stale or null entity handle");
     return e.index;
@@ -135,6 +178,7 @@ class World {
 
   EntityTable entities_;
   std::vector<std::unique_ptr<detail::PoolBase>> pools_;  // indexed by component type id
+  std::vector<ComponentAccess> access_;                   // indexed by component type id
 };
 
 }  // namespace phaco

@@ -12,6 +12,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "engine/core/access_scope.hpp"
 #include "engine/schedule/access_check.hpp"
 
 namespace phaco {
@@ -32,6 +33,23 @@ using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 float elapsed_ms(Clock::time_point t0, Clock::time_point t1) {
   return std::chrono::duration<float, std::milli>(t1 - t0).count();
 }
+
+// A system's declared reads and writes, against which its World lookups are checked while it
+// runs (engine/core/access_scope.hpp).
+class DeclaredAccess final : public AccessScope {
+ public:
+  explicit DeclaredAccess(const SystemDesc& s) : system_(&s) {}
+  void touch(std::string_view access_name) const override {
+    for (const auto* list : {&system_->reads, &system_->writes})
+      for (const std::string& n : *list)
+        if (n == access_name) return;
+    throw std::logic_error("system '" + system_->name + "' touched '" + std::string(access_name) +
+                           "' without declaring it in its reads or writes");
+  }
+
+ private:
+  const SystemDesc* system_;
+};
 
 }  // namespace
 
@@ -61,12 +79,15 @@ struct Executor::Impl {
   std::vector<SystemTiming> timings;
   SystemTiming frame;
   std::optional<AccessTracker> tracker;
+  std::vector<DeclaredAccess> declared;  // per system, where access is checked
   FrameContext ctx;  // the running frame's context; written before any node is released
 
-  Impl(const FrameGraph& g, int n) : graph(g), threads(n), parallelism(raise_parallelism(n)), arena(n) {}
+  Impl(const FrameGraph& g, int n)
+      : graph(g), threads(n), parallelism(raise_parallelism(n)), arena(n) {}
 
   static std::unique_ptr<tbb::global_control> raise_parallelism(int n) {
-    const auto limit = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    const auto limit =
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
     if (static_cast<size_t>(n) <= limit) return nullptr;
     return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                  static_cast<size_t>(n));
@@ -85,6 +106,7 @@ struct Executor::Impl {
     AccessTracker* t = tracker ? &*tracker : nullptr;
     if (t) t->enter(i);
     TrackerExit leave{t, i};
+    const AccessScopeGuard scope(declared.empty() ? nullptr : &declared[i]);
     const Clock::time_point t0 = Clock::now();
     s.run(ctx);
     // Only node i touches timings[i], and once per frame, so no lock is needed.
@@ -112,6 +134,7 @@ Executor::Executor(const FrameGraph& graph, int threads, AccessCheck check) {
       std::abort();
     }
     im.tracker.emplace(graph);
+    for (size_t i = 0; i < graph.size(); ++i) im.declared.emplace_back(graph.system(i));
   }
 
   im.timings.resize(graph.size());

@@ -2,6 +2,8 @@
 //   build/release/perf/bench_engine --benchmark_min_time=0.2
 #include <benchmark/benchmark.h>
 
+#include <oneapi/tbb/task_arena.h>
+
 #include <string>
 #include <vector>
 
@@ -52,6 +54,38 @@ void BM_ParallelForStream(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * n);
 }
 BENCHMARK(BM_ParallelForStream)->Arg(1024)->Arg(4096)->Arg(16384);
+
+// Where a second thread starts to pay (issue 17: "loops below a measured grain run serially"):
+// n elements of about the work of one row of the capsule's implicit operator (a 3×3 block times
+// seven neighbours), split in two chunks on 2 threads, against one chunk on 1 thread. The size at
+// which the 2-thread time falls below the 1-thread time is the grain below which a loop should
+// stay serial (engine/schedule/parallel.hpp runs a range within its grain without a task).
+void BM_ParallelForGrain(benchmark::State& state) {
+  const uint32_t n = static_cast<uint32_t>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  std::vector<double> x(3 * size_t(n) + 64, 1.0), y(3 * size_t(n), 0.0);
+  tbb::task_arena arena(threads);
+  const uint32_t grain = threads == 1 ? n : (n + 1) / 2;
+  for (auto _ : state) {
+    arena.execute([&] {
+      parallel_for(0, n, grain, [&](uint32_t b, uint32_t e, int) {
+        for (uint32_t r = b; r < e; ++r) {
+          double acc[3] = {0.0, 0.0, 0.0};
+          for (uint32_t k = 0; k < 7; ++k) {
+            const double* xs = &x[3 * r + 3 * k];
+            for (int a = 0; a < 3; ++a) acc[a] += 0.5 * xs[0] + 0.25 * xs[1] + 0.125 * xs[2] + a;
+          }
+          y[3 * r] = acc[0], y[3 * r + 1] = acc[1], y[3 * r + 2] = acc[2];
+        }
+      });
+    });
+    benchmark::DoNotOptimize(y.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * n);
+}
+BENCHMARK(BM_ParallelForGrain)
+    ->ArgsProduct({{64, 256, 1024, 4096, 16384}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_Philox(benchmark::State& state) {
   const CounterRng rng(7);

@@ -430,6 +430,7 @@ SystemDesc drill_metrics_system(Scene& scene) {
   // The t = 0 sample: the tools' poses the scene starts from.
   r.t_s.push_back(0.0);
   for (size_t i = 0; i < r.hands.size(); ++i) sample_hand(scene, r, static_cast<int>(i), 0.0, 0.0);
+  scene.world.name_component<DrillRecord>("metrics", AccessKind::Global);
   if (!scene.bodies.empty()) scene.world.add(scene.bodies.front(), std::move(r));
   return {
       .name = "drill_metrics",

@@ -59,6 +59,7 @@ void add_lens_fragments(Scene& scene) {
   lf.previous_pose.resize(scene.tools.size());
   for (size_t i = 0; i < scene.tools.size(); ++i)
     lf.previous_pose[i] = scene.world.at<ToolState>(scene.tools[i]);
+  scene.world.name_component<LensFragments>("cells");
   scene.world.add(e, std::move(lf));
 }
 

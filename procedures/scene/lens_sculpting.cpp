@@ -107,6 +107,7 @@ void add_lens_sculpting(Scene& scene) {
   ls.nucleus = {f * 0.5 * params.get("lens.equatorial_diameter_mm"),
                 f * params.get("lens.anterior_half_thickness_mm"),
                 -f * params.get("lens.posterior_half_thickness_mm")};
+  scene.world.name_component<LensSculpting>("sculpting");
   scene.world.add(lens, std::move(ls));
 }
 
@@ -115,7 +116,7 @@ SystemDesc lens_sculpt_system(Scene& scene) {
   return {.name = "lens_sculpt",
           .phase = Phase::Topology,
           .reads = {"tools.pose"},
-          .writes = {"lens.tets", "lens.particles"},
+          .writes = {"lens.tets", "lens.particles", "lens.sculpting"},
           .run = [&scene, lens](const FrameContext& ctx) {
             LensSculpting& ls = scene.world.at<LensSculpting>(lens);
             for (Entity e : scene.tools) {

@@ -213,6 +213,18 @@ void check_methods(const Scenario& s, const std::vector<BodyPart>& parts) {
   }
 }
 
+// Access names of the components every scene has (the check of declared access, SystemDesc);
+// each add_* function names the components it adds.
+void name_base_components(World& world) {
+  world.name_component<Body>("body", AccessKind::Constant);
+  world.name_component<Particles>("particles");
+  world.name_component<Triangles>("triangles");
+  world.name_component<Tets>("tets");
+  world.name_component<Tool>("kind", AccessKind::Constant);
+  world.name_component<ToolTrack>("track");
+  world.name_component<ToolState>("pose");
+}
+
 std::vector<SystemDesc> base_systems(Scene& scene) {
   std::vector<SystemDesc> systems;
   systems.push_back({.name = "move_tools",
@@ -301,6 +313,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   replace_meshes_from_files(scenario, meshes);
   scene->mesh_load_s = mesh_clock.elapsed_s();
 
+  name_base_components(scene->world);
   for (BodyPart part : parts) add_body(*scene, part, meshes);
   for (const HandTrack& hand : scenario.hands) {
     const Entity e = scene->world.create(EntityKind::Tool, std::string(to_string(hand.hand)) + "." +
@@ -335,8 +348,16 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   if (options.extra_systems) {
     for (auto& s : options.extra_systems(*scene)) systems.push_back(std::move(s));
   }
+  // apply_commands is the frame's sync point for structural change only where a system records
+  // commands (declares writes "world.commands"). Where none does it has nothing to apply, and as
+  // a barrier it would only keep the port solve, the capsule and the metrics from overlapping.
+  const bool records = std::any_of(systems.begin(), systems.end(), [](const SystemDesc& s) {
+    return std::find(s.writes.begin(), s.writes.end(), "world.commands") != s.writes.end();
+  });
+  for (SystemDesc& s : systems)
+    if (s.name == "apply_commands") s.barrier = records, s.reads = {"world.commands"};
   scene->graph = std::make_unique<FrameGraph>(std::move(systems));
-  scene->executor = std::make_unique<Executor>(*scene->graph, options.threads);
+  scene->executor = std::make_unique<Executor>(*scene->graph, options.threads, options.access_check);
   return scene;
 }
 

@@ -39,6 +39,9 @@ struct SceneOptions {
   // A haptic runtime (issue 6): device-driven hands take their pose from it, and the frame ends by
   // publishing the local haptic model to it. Null: every hand follows its track, nothing published.
   HapticPort* haptics = nullptr;
+  // Whether the executor checks, while systems run, that they touch only what they declared and
+  // never race (engine/schedule/executor.hpp). BuildDefault: on in debug builds.
+  AccessCheck access_check = AccessCheck::BuildDefault;
 };
 
 struct Scene {

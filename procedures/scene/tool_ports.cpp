@@ -124,6 +124,7 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
   r.stress_force_mn = target != scene.drill.targets.end() && target->second.max
                           ? *target->second.max
                           : std::numeric_limits<double>::infinity();
+  scene.world.name_component<PortsRecord>("tools.ports", AccessKind::Global);
   scene.world.add(scene.bodies.front(), std::move(r));
 
   std::vector<std::string> writes = {"tools.ports"};

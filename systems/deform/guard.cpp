@@ -133,10 +133,21 @@ uint32_t sanitize_and_save(Membrane& m, Snapshot& snap) {
   Particles& p = m.particles;
   const uint32_t n = p.slots.size();
   uint32_t repaired = 0;
-  if (snap.x.size() != n) {  // first use: repair against nothing, then copy every particle
+  if (snap.x.size() > n || snap.x.empty()) {  // first use: repair against nothing, copy every particle
     for (uint32_t i = 0; i < n; ++i) repaired += repair(m, snap, i) ? 1 : 0;
     snap.x = p.x, snap.y = p.y, snap.z = p.z, snap.vx = p.vx, snap.vy = p.vy, snap.vz = p.vz;
     return repaired;
+  }
+  if (snap.x.size() < n) {
+    // A cut or a tear added particles at the end of the table: save just those (amortised
+    // growth), not the whole mesh again, so a cut frame costs what the cut touched (issue 17).
+    const uint32_t old_n = static_cast<uint32_t>(snap.x.size());
+    for (uint32_t i = old_n; i < n; ++i) repaired += repair(m, snap, i) ? 1 : 0;  // no snapshot yet
+    for (auto* col : {&snap.x, &snap.y, &snap.z, &snap.vx, &snap.vy, &snap.vz}) col->resize(n);
+    for (uint32_t i = old_n; i < n; ++i) {
+      snap.x[i] = p.x[i], snap.y[i] = p.y[i], snap.z[i] = p.z[i];
+      snap.vx[i] = p.vx[i], snap.vy[i] = p.vy[i], snap.vz[i] = p.vz[i];
+    }
   }
   const ParticleSet set = particles_in_play(m);
   for (const uint32_t e : m.active_springs) {  // sleeping ends are read by the spring pass

@@ -9,20 +9,13 @@
 #include "engine/schedule/executor.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "tests/engine/schedule/alloc_counter.hpp"
+#include "tests/engine/schedule/make_system.hpp"
 #include "tests/engine/schedule/random_systems.hpp"
 
 namespace phaco {
 namespace {
 
-SystemDesc sys(std::string name, std::vector<std::string> reads, std::vector<std::string> writes,
-               std::function<void(const FrameContext&)> run) {
-  SystemDesc s;
-  s.name = std::move(name);
-  s.reads = std::move(reads);
-  s.writes = std::move(writes);
-  s.run = std::move(run);
-  return s;
-}
+using test::make_system;
 
 // Per-system record of the last frame: tickets from one global counter bracket each run.
 struct RunLog {
@@ -93,8 +86,8 @@ TEST(Executor, IndependentSystemsRunConcurrently) {
     }
     if (arrived.load() >= 2) saw_other.fetch_add(1);
   };
-  const FrameGraph graph({sys("left_hand", {"tools.pose"}, {"left.grip"}, meet),
-                          sys("right_hand", {"tools.pose"}, {"right.grip"}, meet)});
+  const FrameGraph graph({make_system("left_hand", {"tools.pose"}, {"left.grip"}, meet),
+                          make_system("right_hand", {"tools.pose"}, {"right.grip"}, meet)});
   ASSERT_FALSE(graph.ordered(0, 1));
   Executor ex(graph, 2, AccessCheck::On);
   ex.run_frame({});
@@ -103,8 +96,8 @@ TEST(Executor, IndependentSystemsRunConcurrently) {
 }
 
 TEST(Executor, RecordsOneTimingSamplePerFrame) {
-  const FrameGraph graph({sys("a", {}, {"x"}, [](const FrameContext&) {}),
-                          sys("b", {"x"}, {}, [](const FrameContext&) {})});
+  const FrameGraph graph({make_system("a", {}, {"x"}, [](const FrameContext&) {}),
+                          make_system("b", {"x"}, {}, [](const FrameContext&) {})});
   Executor ex(graph, 2);
   constexpr size_t kFrames = 40;
   for (size_t f = 0; f < kFrames; ++f) ex.run_frame({f, 0, 0});
@@ -135,13 +128,14 @@ TEST(Executor, PercentilesUseNearestRank) {
 
 TEST(Executor, SystemExceptionReachesCallerAndExecutorRecovers) {
   std::atomic<int> runs_a{0}, runs_b{0}, runs_c{0};
-  const FrameGraph graph({sys("a", {}, {"x"}, [&](const FrameContext&) { ++runs_a; }),
-                          sys("b", {"x"}, {"y"},
-                              [&](const FrameContext& ctx) {
-                                ++runs_b;
-                                if (ctx.frame == 1) throw std::runtime_error("mesh went bad");
-                              }),
-                          sys("c", {"y"}, {}, [&](const FrameContext&) { ++runs_c; })});
+  const FrameGraph graph({make_system("a", {}, {"x"}, [&](const FrameContext&) { ++runs_a; }),
+                          make_system("b", {"x"}, {"y"},
+                                      [&](const FrameContext& ctx) {
+                                        ++runs_b;
+                                        if (ctx.frame == 1)
+                                          throw std::runtime_error("mesh went bad");
+                                      }),
+                          make_system("c", {"y"}, {}, [&](const FrameContext&) { ++runs_c; })});
   Executor ex(graph, 2, AccessCheck::On);
   ex.run_frame({0, 0, 0});
   EXPECT_THROW(ex.run_frame({1, 0, 0}), std::runtime_error);
@@ -167,7 +161,7 @@ TEST(Executor, ParallelForInsideSystemUsesTheExecutorsWorkers) {
     std::atomic<int> seen_workers{0};
     std::atomic<int> bad_worker{0};
     std::vector<int> out(10000, 0);
-    const FrameGraph graph({sys("fill", {}, {"out"}, [&](const FrameContext&) {
+    const FrameGraph graph({make_system("fill", {}, {"out"}, [&](const FrameContext&) {
       seen_workers = worker_count();
       parallel_for(0, static_cast<uint32_t>(out.size()), 64, [&](uint32_t b, uint32_t e, int w) {
         if (w < 0 || w >= worker_count()) ++bad_worker;
@@ -188,7 +182,7 @@ TEST(Executor, FrameAllocatesNothingOnOneThread) {
   float total = 0;
   auto systems = test::random_systems(20, 6, 5);
   for (auto& s : systems) s.run = [](const FrameContext&) {};
-  systems.push_back(sys("reduce", {"data"}, {"total"}, [&](const FrameContext&) {
+  systems.push_back(make_system("reduce", {"data"}, {"total"}, [&](const FrameContext&) {
     total = parallel_reduce_ordered(
         0, 4096, 256, 0.0f,
         [&](uint32_t b, uint32_t e) {
