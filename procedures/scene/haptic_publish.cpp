@@ -9,6 +9,7 @@
 #include "components/tool.hpp"
 #include "components/triangles.hpp"
 #include "engine/core/clock.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/scene.hpp"
 
@@ -27,10 +28,11 @@ void clear_tool(HapticTool& t) {
   t.damping_mn_s_per_mm = 0;
 }
 
-uint32_t nearest_capsule_particle(const Particles& p, const Vec3& tip, double radius_mm) {
+// Every particle once, for a capsule integrated whole (no active set: no locality to keep).
+uint32_t nearest_by_scan(const Particles& p, uint32_t n, const Vec3& tip, double radius_mm) {
   double best = radius_mm * radius_mm;
   uint32_t best_i = kInvalidIndex;
-  for (uint32_t i = 0; i < p.slots.size(); ++i) {
+  for (uint32_t i = 0; i < n; ++i) {
     if (!p.slots.alive(i)) continue;
     const double dx = p.x[i] - tip.x(), dy = p.y[i] - tip.y(), dz = p.z[i] - tip.z();
     const double d2 = dx * dx + dy * dy + dz * dz;
@@ -80,6 +82,56 @@ uint32_t gather_ball(const SpringGraph& graph, const Particles& p, uint32_t seed
   return free_count;
 }
 
+// Keeps the bins of the capsule's particles current (systems/point_bins): all of them once, then
+// each frame the active set (the only particles the step moved, a cut's new ones among them: they
+// seed the set) and any appended since. A capsule integrated whole is scanned instead.
+void track_capsule_particles(const Scene& scene, Entity capsule,
+                             const HapticPublishSettings& settings, HapticPublishScratch& s) {
+  const Particles& p = *scene.world.get<Particles>(capsule);
+  const CapsulePhysics& cp = *scene.world.get<CapsulePhysics>(capsule);
+  if (!cp.use_active_set) return;
+  if (s.bins.key_of.empty()) {
+    point_bins::bin_all(s.bins, p, 0.5 * settings.contact_radius_mm);
+    return;
+  }
+  point_bins::rebin(s.bins, p, cp.active.particles);
+  point_bins::bin_appended(s.bins, p);
+}
+
+// Capsule triangles with three local corners into s.near_triangles (squared distance of the
+// centroid to the tip, triangle). With the cut's vertex-to-triangle index, from the fans of the
+// local nodes, each triangle once (from its corner of lowest local index): a walk over the ball,
+// not the mesh. Without it (capsule.cutting off), a scan of every triangle.
+void gather_patch(const Particles& p, const Triangles& tris, const CapsuleCutting* cutting,
+                  const Vec3& tip, HapticPublishScratch& s) {
+  s.near_triangles.clear();
+  const auto consider = [&](uint32_t f, uint16_t from_local) {
+    const uint32_t a = tris.a[f], b = tris.b[f], c = tris.c[f];
+    if (a >= s.local.size() || b >= s.local.size() || c >= s.local.size()) return;
+    const uint16_t la = s.local[a], lb = s.local[b], lc = s.local[c];
+    if (la == kHapticNoNode || lb == kHapticNoNode || lc == kHapticNoNode) return;
+    if (from_local != kHapticNoNode && from_local != std::min({la, lb, lc})) return;
+    const double cx = (p.x[a] + p.x[b] + p.x[c]) / 3.0 - tip.x();
+    const double cy = (p.y[a] + p.y[b] + p.y[c]) / 3.0 - tip.y();
+    const double cz = (p.z[a] + p.z[b] + p.z[c]) / 3.0 - tip.z();
+    s.near_triangles.emplace_back(static_cast<float>(cx * cx + cy * cy + cz * cz), f);
+  };
+  const cut::MembraneTopology* topo = cutting ? &cutting->topology : nullptr;
+  if (!topo) {
+    for (uint32_t f = 0; f < tris.slots.size(); ++f)
+      if (tris.slots.alive(f)) consider(f, kHapticNoNode);
+    return;
+  }
+  for (size_t l = 0; l < s.nodes.size(); ++l) {
+    const uint32_t v = s.nodes[l];
+    if (v >= topo->vertex_triangle.size()) continue;
+    const uint32_t hint = topo->vertex_triangle[v];
+    if (hint >= tris.slots.size() || !tris.slots.alive(hint)) continue;
+    cut::vertex_fan(tris, topo->adjacency, hint, v, s.fan);
+    for (uint32_t f : s.fan) consider(f, static_cast<uint16_t>(l));
+  }
+}
+
 void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSettings& settings,
                   HapticPublishScratch& s, const Vec3& tip, uint32_t grasped, HapticTool& t) {
   const Particles& p = *scene.world.get<Particles>(capsule);
@@ -89,7 +141,8 @@ void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSetting
   const uint32_t n = std::min(p.slots.size(), graph.particle_count());
   uint32_t seed = grasped;
   if (seed == kInvalidIndex || seed >= n)
-    seed = nearest_capsule_particle(p, tip, settings.contact_radius_mm);
+    seed = cp.use_active_set ? point_bins::nearest(s.bins, p, tip, settings.contact_radius_mm)
+                             : nearest_by_scan(p, n, tip, settings.contact_radius_mm);
   if (seed == kInvalidIndex || seed >= n) return;
 
   if (s.local.size() < p.slots.size()) s.local.resize(p.slots.size(), kHapticNoNode);
@@ -137,18 +190,7 @@ void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSetting
                                       scene.params.get("capsule_model.viscosity_per_s")));
 
   // Patch: triangles with three local corners, nearest the tip first.
-  s.near_triangles.clear();
-  for (uint32_t f = 0; f < tris.slots.size(); ++f) {
-    if (!tris.slots.alive(f)) continue;
-    const uint32_t a = tris.a[f], b = tris.b[f], c = tris.c[f];
-    if (a >= s.local.size() || b >= s.local.size() || c >= s.local.size()) continue;
-    if (s.local[a] == kHapticNoNode || s.local[b] == kHapticNoNode || s.local[c] == kHapticNoNode)
-      continue;
-    const double cx = (p.x[a] + p.x[b] + p.x[c]) / 3.0 - tip.x();
-    const double cy = (p.y[a] + p.y[b] + p.y[c]) / 3.0 - tip.y();
-    const double cz = (p.z[a] + p.z[b] + p.z[c]) / 3.0 - tip.z();
-    s.near_triangles.emplace_back(static_cast<float>(cx * cx + cy * cy + cz * cz), f);
-  }
+  gather_patch(p, tris, scene.world.get<CapsuleCutting>(capsule), tip, s);
   const size_t keep = std::min<size_t>(s.near_triangles.size(), kHapticMaxTriangles);
   std::partial_sort(s.near_triangles.begin(),
                     s.near_triangles.begin() + static_cast<std::ptrdiff_t>(keep),
@@ -200,6 +242,7 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
   const auto capsule = scene.body(BodyPart::Capsule);
   const bool has_capsule_physics = capsule && scene.world.get<CapsulePhysics>(*capsule);
   const bool has_lens = scene.body(BodyPart::Lens) || scene.body(BodyPart::LensSurface);
+  if (has_capsule_physics) track_capsule_particles(scene, *capsule, settings, scratch);
   for (Entity e : scene.tools) {
     const Tool& tool = *scene.world.get<Tool>(e);
     HapticTool& t = model.tools[static_cast<size_t>(tool.hand) % kHapticTools];
@@ -238,7 +281,7 @@ SystemDesc haptic_publish_system(Scene& scene) {
   return {.name = "publish_haptics",
           .phase = Phase::Publish,
           .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.physics",
-                    "capsule.triangles"},
+                    "capsule.triangles", "capsule.cutting"},
           .writes = {"haptics.model"},
           .run = [&scene, settings, scratch](const FrameContext&) {
             HapticModel& slot = scene.haptics->model_slot();

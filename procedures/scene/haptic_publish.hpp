@@ -14,14 +14,18 @@
 //            the phaco probe in the sculpting scene, which goes into the lens on purpose (the
 //            resistance of the nucleus to the probe is not modelled)
 //
-// Cost: a scan of the capsule's particles and triangles per tool (≈ 8k and 16k at level 3), a
-// breadth-first walk of the ball, and a ≈ 62 KiB model write. Reads: tools.pose, tools.grasp,
+// Cost: re-binning the active set (systems/point_bins), then per tool the bins within the contact
+// radius, a breadth-first walk of the ball and of its triangle fans, and a ≈ 62 KiB model write:
+// what the tools touch, not the mesh (issue 17). Whole scans remain where there is no locality to
+// keep: the first frame's binning, a capsule without an active set, and, with capsule.cutting off,
+// the patch (no vertex-to-triangle index). Reads: tools.pose, tools.grasp,
 // capsule.particles, capsule.physics, capsule.triangles. Writes: haptics.model.
 #include <cstdint>
 #include <vector>
 
 #include "components/haptic_model.hpp"
 #include "engine/schedule/system.hpp"
+#include "systems/point_bins/point_bins.hpp"
 
 namespace phaco {
 
@@ -41,6 +45,8 @@ struct HapticPublishScratch {
   std::vector<uint32_t> nodes;  // local → capsule particle
   std::vector<uint32_t> layer, next;
   std::vector<std::pair<float, uint32_t>> near_triangles;  // squared distance to the tip, triangle
+  std::vector<uint32_t> fan;                               // one node's triangles
+  point_bins::PointBins bins;  // the capsule's particles, for the nearest
 };
 
 // The settings from the eye parameters' haptic_model section.

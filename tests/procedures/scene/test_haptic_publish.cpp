@@ -4,7 +4,9 @@
 // ring — and must follow the tools (grasp, distance, lens).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "components/particles.hpp"
@@ -113,6 +115,59 @@ TEST(HapticPublish, TheGraspedFlapComesWithItsWholeNeighbourhood) {
   EXPECT_GT(t.lens_stiffness_mn_per_mm, 0.0f);
 }
 
+// The local searches (bins re-binned from the active set, the ball's triangle fans) give what
+// whole-mesh scans give: at every 10th frame of the demo, for every tool near the capsule and not
+// holding it, the seed is the particle nearest the tip, and the patch holds every triangle with
+// three local corners.
+TEST(HapticPublish, LocalSearchesMatchWholeMeshScans) {
+  const Scenario s = test::repo_scenario("capsulorhexis_demo.json");
+  CapturePort port;
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  o.haptics = &port;
+  auto scene = build_scene(s, o);
+  const HapticPublishSettings settings = haptic_publish_settings(*scene);
+  HapticPublishScratch warm;
+  HapticModel model;
+  const Entity capsule = *scene->body(BodyPart::Capsule);
+  uint32_t compared_seeds = 0, compared_patches = 0;
+  const auto frames = static_cast<uint64_t>(std::llround(8.0 / s.dt_s));
+  for (uint64_t f = 0; f < frames; ++f) {
+    step(*scene);
+    build_haptic_model(*scene, settings, warm, model);  // every frame, as the system does
+    if (f % 10 != 0) continue;
+    const Particles& p = scene->world.at<Particles>(capsule);
+    const Triangles& tris = scene->world.at<Triangles>(capsule);
+    for (Entity tool : scene->tools) {
+      const Vec3 tip = scene->world.at<ToolState>(tool).pos;
+      const HapticTool& t = model.tools[static_cast<size_t>(scene->world.at<Tool>(tool).hand)];
+      if (t.node_count == 0 || t.grasped_node != kHapticNoNode) continue;
+      double best = std::numeric_limits<double>::infinity();  // over every live particle
+      for (uint32_t i = 0; i < p.slots.size(); ++i) {
+        if (!p.slots.alive(i)) continue;
+        const double dx = p.x[i] - tip.x(), dy = p.y[i] - tip.y(), dz = p.z[i] - tip.z();
+        best = std::min(best, dx * dx + dy * dy + dz * dz);
+      }
+      const double sx = t.x[0] - tip.x(), sy = t.y[0] - tip.y(), sz = t.z[0] - tip.z();  // the seed
+      EXPECT_EQ(sx * sx + sy * sy + sz * sz, best) << "frame " << f;
+      ++compared_seeds;
+    }
+    // The patch of the last tool built: every triangle whose corners are all local, by scan.
+    if (warm.nodes.empty()) continue;
+    const auto local = [&](uint32_t v) {
+      return std::find(warm.nodes.begin(), warm.nodes.end(), v) != warm.nodes.end();
+    };
+    size_t local_triangles = 0;
+    for (uint32_t fi = 0; fi < tris.slots.size(); ++fi)
+      local_triangles +=
+          tris.slots.alive(fi) && local(tris.a[fi]) && local(tris.b[fi]) && local(tris.c[fi]);
+    EXPECT_EQ(warm.near_triangles.size(), local_triangles) << "frame " << f;
+    ++compared_patches;
+  }
+  EXPECT_GT(compared_seeds, 5u) << "the tools come near the capsule in the demo";
+  EXPECT_GT(compared_patches, 5u);
+}
+
 TEST(HapticPublish, ATipFarFromTheCapsuleGetsNoNodes) {
   CapturePort port;
   // At the start the cystotome (right hand) waits at z = 3.5, 1.7 mm above the capsule.
@@ -154,8 +209,10 @@ TEST(HapticPublish, TheBallGrowsWithTheHopsAndStaysWithinCapacity) {
     for (uint32_t s = 0; s < t.spring_count; ++s) ++degree[t.spring_i[s]], ++degree[t.spring_j[s]];
     uint32_t anchored = 0;
     for (uint32_t l = 0; l < t.node_count; ++l) {
-      if (t.kind[l] == HapticNodeKind::Anchored) ++anchored;
-      else EXPECT_GE(degree[l], 2u) << "a free node held by its springs";
+      if (t.kind[l] == HapticNodeKind::Anchored)
+        ++anchored;
+      else
+        EXPECT_GE(degree[l], 2u) << "a free node held by its springs";
     }
     EXPECT_GT(anchored, 0u) << "the outer layer holds the ball";
   }
