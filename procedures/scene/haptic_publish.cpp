@@ -53,7 +53,7 @@ uint32_t gather_ball(const SpringGraph& graph, const Particles& p, uint32_t seed
     // The next layer: neighbours of this one not yet local.
     s.next.clear();
     for (uint32_t v : s.layer) {
-      for (uint32_t k = graph.offset[v]; k < graph.offset[v + 1]; ++k) {
+      for (uint32_t k = graph.begin(v); k < graph.end(v); ++k) {
         const uint32_t w = graph.neighbour[k];
         if (w >= p.slots.size() || !p.slots.alive(w) || s.local[w] != kHapticNoNode) continue;
         s.local[w] = 0;  // marked; numbered below
@@ -83,7 +83,7 @@ uint32_t gather_ball(const SpringGraph& graph, const Particles& p, uint32_t seed
 void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSettings& settings,
                   HapticPublishScratch& s, const Vec3& tip, uint32_t grasped, HapticTool& t) {
   const Particles& p = *scene.world.get<Particles>(capsule);
-  const CapsulePhysics& cp = *scene.world.get<CapsulePhysics>(capsule);
+  const CapsuleSprings& cp = *scene.world.get<CapsuleSprings>(capsule);
   const Triangles& tris = *scene.world.get<Triangles>(capsule);
   const SpringGraph& graph = cp.graph;
   const uint32_t n = std::min(p.slots.size(), graph.particle_count());
@@ -116,7 +116,7 @@ void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSetting
   // Springs between local nodes with at least one free end, each once (from its lower local end).
   for (uint32_t l = 0; l < t.node_count && t.spring_count < kHapticMaxSprings; ++l) {
     const uint32_t v = s.nodes[l];
-    for (uint32_t k = graph.offset[v]; k < graph.offset[v + 1]; ++k) {
+    for (uint32_t k = graph.begin(v); k < graph.end(v); ++k) {
       const uint32_t w = graph.neighbour[k];
       const uint16_t lw = s.local[w];
       if (lw == kHapticNoNode || lw <= l) continue;
@@ -198,7 +198,7 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
   for (HapticTool& t : model.tools) clear_tool(t);
 
   const auto capsule = scene.body(BodyPart::Capsule);
-  const bool has_capsule_physics = capsule && scene.world.get<CapsulePhysics>(*capsule);
+  const bool has_capsule_physics = capsule && scene.world.get<CapsuleSprings>(*capsule);
   const bool has_lens = scene.body(BodyPart::Lens) || scene.body(BodyPart::LensSurface);
   for (Entity e : scene.tools) {
     const Tool& tool = *scene.world.get<Tool>(e);
@@ -237,7 +237,7 @@ SystemDesc haptic_publish_system(Scene& scene) {
   auto scratch = std::make_shared<HapticPublishScratch>();
   return {.name = "publish_haptics",
           .phase = Phase::Publish,
-          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.physics",
+          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.springs",
                     "capsule.triangles"},
           .writes = {"haptics.model"},
           .run = [&scene, settings, scratch](const FrameContext&) {

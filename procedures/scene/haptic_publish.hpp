@@ -16,7 +16,7 @@
 //
 // Cost: a scan of the capsule's particles and triangles per tool (≈ 8k and 16k at level 3), a
 // breadth-first walk of the ball, and a ≈ 62 KiB model write. Reads: tools.pose, tools.grasp,
-// capsule.particles, capsule.physics, capsule.triangles. Writes: haptics.model.
+// capsule.particles, capsule.springs, capsule.triangles. Writes: haptics.model.
 #include <cstdint>
 #include <vector>
 

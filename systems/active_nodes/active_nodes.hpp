@@ -32,7 +32,9 @@
 
 namespace phaco::active_nodes {
 
-// The spring graph (components/springs.hpp) comes from springs::build_spring_graph.
+// The spring graph (components/springs.hpp) comes from springs::build_spring_graph and, after a
+// cut or tear, springs::patch_spring_graph. A graph with more particles than the last update's
+// (a cut added some) keeps the set: the new particles' marks are appended, nothing is reset.
 
 struct WakeInputs {
   // Positions and velocities after the last step; null: no wake rules (only the seeds' ball).
