@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "components/particles.hpp"
 #include "components/tool.hpp"
@@ -13,6 +15,7 @@
 #include "procedures/scene/scene.hpp"
 #include "systems/cut/spring_order.hpp"
 #include "systems/springs/springs.hpp"
+#include "systems/topology_check/topology_check.hpp"
 
 namespace phaco {
 
@@ -85,6 +88,16 @@ void compact_physics(cut::CutMesh& m, CapsuleSprings& sp) {
   sp.blocks = springs::plan_blocks(sp.springs, n);
   sp.graph = springs::build_spring_graph(sp.springs, n);
   ++sp.version;
+}
+
+// Debug builds check the patched structure against a fresh build after every change (O(S log S));
+// release builds leave it to the tests.
+void check_patched_physics(const CapsuleSprings& sp, uint32_t particle_count) {
+  if constexpr (topology_check::kCheckEveryFrame) {
+    const std::string problem =
+        topology_check::check_spring_structure(sp.springs, sp.blocks, sp.graph, particle_count);
+    if (!problem.empty()) throw std::logic_error("capsule springs after a cut: " + problem);
+  }
 }
 
 // The particles this frame's edits made become sources (seeds of the active set).
@@ -289,6 +302,7 @@ SystemDesc capsule_cut_system(Scene& scene) {
             compact_physics(m, sp);
             ++cc.compactions;
             cc.compaction_ms_total += elapsed_ms(t2);
+            check_patched_physics(sp, p.slots.size());
           }
           return;
         }
@@ -299,6 +313,7 @@ SystemDesc capsule_cut_system(Scene& scene) {
         cc.refresh_ms_total += refresh_ms;
         cc.refresh_ms_max = std::max(cc.refresh_ms_max, refresh_ms);
         ++cc.topology_changes;
+        check_patched_physics(sp, p.slots.size());
       }};
 }
 

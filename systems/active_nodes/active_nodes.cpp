@@ -44,15 +44,21 @@ void clear_active_set(ActiveSet& set) {
 void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds, uint32_t k_hops,
                        const WakeInputs& wake, ActiveSet& set) {
   const uint32_t n = graph.particle_count();
-  if (set.mark.size() > n) {  // a smaller body than last time (a different body): start afresh
-    set.mark.assign(n, 0);
-    set.previous.assign(n, 0);
+  if (set.mark.size() != n) {
+    // First use, or a cut changed the particle count: the set starts afresh from the seeds (as it
+    // always has after a topology change). The marks are cleared through the list that set them
+    // and grow for the new particles (amortised, with room left at first use): no pass over the
+    // body.
+    for (uint32_t p : set.particles)
+      if (p < set.mark.size()) set.mark[p] = 0;
     set.particles.clear();
+    if (set.mark.capacity() < n) {
+      set.mark.reserve(size_t{n} + n / 4 + 64);
+      set.previous.reserve(size_t{n} + n / 4 + 64);
+    }
+    set.mark.resize(n, 0);
+    set.previous.resize(n, 0);
   }
-  // First use, or a cut added particles: new ones are unmarked; the set carries over (amortised
-  // growth, not a pass over the body).
-  set.mark.resize(n, 0);
-  set.previous.resize(n, 0);
   // Last update's set becomes `previous`; marks are cleared through it.
   set.previous_list.assign(set.particles.begin(), set.particles.end());
   for (uint32_t p : set.previous_list) set.mark[p] = 0, set.previous[p] = 1;

@@ -108,6 +108,10 @@ SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count) 
     ++g.row_size[springs.i[e]];
     ++g.row_size[springs.j[e]];
   }
+  // Room for the particles and row moves that cuts add, so a cut frame does not reallocate (and
+  // copy) per-particle arrays the size of the mesh; beyond that they grow geometrically.
+  const size_t room = size_t{particle_count} + particle_count / 4 + 64;
+  g.row_begin.reserve(room), g.row_size.reserve(room), g.row_capacity.reserve(room);
   g.row_begin.resize(particle_count);
   g.row_capacity.resize(particle_count);
   uint32_t at = 0;
@@ -117,7 +121,7 @@ SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count) 
     at += g.row_capacity[p];
   }
   // Room for rows that move when they outgrow their slack, so the first cuts do not reallocate.
-  g.neighbour.reserve(at + at / 8), g.spring.reserve(at + at / 8);
+  g.neighbour.reserve(at + at / 4 + 512), g.spring.reserve(at + at / 4 + 512);
   g.neighbour.assign(at, kInvalidIndex);
   g.spring.assign(at, kInvalidIndex);
   std::vector<uint32_t> fill(g.row_begin);
