@@ -35,9 +35,10 @@ bool cut_surface(cut::CutMesh& m, SurfaceCutter& s, const incision::BladeSection
     s.started = true;
     s.puncture = sec.puncture;
     // A walk from an arbitrary triangle could settle on the other cap of the closed shell (a
-    // local minimum of the distance): start from the nearest triangle, found once by a scan.
+    // local minimum of the distance): start from the nearest triangle — the caller's start
+    // triangle if it gave one (a grid lookup), else found by a scan of the whole mesh.
     left.path.hint_triangle = cut::locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
-                                                    kInvalidIndex, s.puncture, settings.snap)
+                                                    s.start_triangle, s.puncture, settings.snap)
                                   .triangle;
     cut::cut_towards(m, left.path, s.puncture, settings, log);
   }

@@ -29,6 +29,9 @@ struct SidePath {
 struct SurfaceCutter {
   bool started = false;
   Vec3 puncture = Vec3::Zero();
+  // Where the puncture's search starts (e.g. cut::nearest_binned_triangle); kInvalidIndex: a scan
+  // of every triangle finds it.
+  uint32_t start_triangle = kInvalidIndex;
   SidePath side[2];
   uint32_t tips[2] = {kInvalidIndex, kInvalidIndex};  // crack tips, kept when the paths end
 };

@@ -33,7 +33,7 @@ PropagationStudy propagation_error_study(const PropagationCase& c) {
   // The grasp: centre vertex and its neighbours, scripted.
   const SpringGraph graph = springs::build_spring_graph(springs, n);
   std::vector<uint32_t> grasp = {0};
-  for (uint32_t r = graph.offset[0]; r < graph.offset[1]; ++r) grasp.push_back(graph.neighbour[r]);
+  for (uint32_t r = graph.begin(0); r < graph.end(0); ++r) grasp.push_back(graph.neighbour[r]);
   study.grasped = static_cast<uint32_t>(grasp.size());
   const Vec3 move(c.grasp_move_mm[0], c.grasp_move_mm[1], c.grasp_move_mm[2]);
   for (uint32_t v : grasp) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "components/particles.hpp"
 #include "components/tool.hpp"
@@ -13,6 +15,7 @@
 #include "procedures/scene/scene.hpp"
 #include "systems/cut/spring_order.hpp"
 #include "systems/springs/springs.hpp"
+#include "systems/topology_check/topology_check.hpp"
 
 namespace phaco {
 
@@ -49,21 +52,52 @@ Vec3 flap_force(const cut::CutMesh& m, uint32_t held) {
   return -pull;
 }
 
-// Brings the capsule's physics up to date after this frame's edits.
-void refresh_physics(cut::CutMesh& m, CapsulePhysics& cp, const cut::EditLog& log) {
-  cut::compact_and_sort_springs(m);
+// Brings the capsule's physics up to date after this frame's edits, touching only what they
+// touched: the new springs are already in the blocks' tail (the edits append them), the removed
+// ones are tombstones with stiffness 0; the graph's rows of their ends are patched; glue grows for
+// the new particles (amortised, the arrays were reserved). No pass over the whole capsule.
+void refresh_physics(cut::CutMesh& m, CapsuleSprings& sp, const cut::EditLog& log) {
   const uint32_t n = m.particles.slots.size();
-  cp.forces.resize_zero(n);
-  cp.glue.x.resize(n), cp.glue.y.resize(n), cp.glue.z.resize(n);
+  sp.glue.x.resize(n), sp.glue.y.resize(n), sp.glue.z.resize(n);
   for (uint32_t v : log.new_particles) {
     if (v >= n) continue;
     const Vec3 r = cut::rest_position(m.topology, v);
-    cp.glue.x[v] = static_cast<float>(r.x()), cp.glue.y[v] = static_cast<float>(r.y()),
-    cp.glue.z[v] = static_cast<float>(r.z());
+    sp.glue.x[v] = static_cast<float>(r.x()), sp.glue.y[v] = static_cast<float>(r.y()),
+    sp.glue.z[v] = static_cast<float>(r.z());
   }
-  cp.blocks = springs::plan_blocks(cp.springs, n);
-  cp.graph = springs::build_spring_graph(cp.springs, n);
-  cp.state.implicit.invalidate();
+  springs::patch_spring_graph(sp.graph, sp.springs, n, m.topology.removed_springs,
+                              m.topology.added_springs);
+  m.topology.added_springs.clear(), m.topology.removed_springs.clear();
+  ++sp.version;
+}
+
+// The tail and the tombstones are work every force pass does serially or for nothing; once they
+// reach a fraction of the table the springs are compacted, sorted and re-planned, and the graph
+// rebuilt — a pass over the whole capsule, so only in a frame without topology change, and rare:
+// after about compact_fraction × springs changed springs, so amortised O(log S) per change.
+bool compaction_due(const CapsuleSprings& sp, const CapsuleCutting& cc) {
+  const uint32_t size = sp.springs.slots.size(), live = sp.springs.slots.live_count();
+  const uint32_t unplanned = (size - sp.blocks.tail_begin()) + (size - live);
+  return unplanned > std::max<uint32_t>(cc.compact_min_springs,
+                                        static_cast<uint32_t>(cc.compact_fraction * live));
+}
+
+void compact_physics(cut::CutMesh& m, CapsuleSprings& sp) {
+  cut::compact_and_sort_springs(m);
+  const uint32_t n = m.particles.slots.size();
+  sp.blocks = springs::plan_blocks(sp.springs, n);
+  sp.graph = springs::build_spring_graph(sp.springs, n);
+  ++sp.version;
+}
+
+// Debug builds check the patched structure against a fresh build after every change (O(S log S));
+// release builds leave it to the tests.
+void check_patched_physics(const CapsuleSprings& sp, uint32_t particle_count) {
+  if constexpr (topology_check::kCheckEveryFrame) {
+    const std::string problem =
+        topology_check::check_spring_structure(sp.springs, sp.blocks, sp.graph, particle_count);
+    if (!problem.empty()) throw std::logic_error("capsule springs after a cut: " + problem);
+  }
 }
 
 // The particles this frame's edits made become sources (seeds of the active set).
@@ -88,7 +122,8 @@ void prune_sources(CapsuleCutting& cc, uint64_t frame) {
 // Forceps: a temporary vertex under the tip the frame they close (seed 000 Fig. 9), removed the
 // frame after systems/grasp has let go. Made on the deformed capsule; new particles are placed
 // already, so their origins are not replayed, and the rest mirror gets their rest positions.
-void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, const CapsulePhysics& cp) {
+void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc,
+                                const CapsuleSettings& cs) {
   cc.forceps.resize(scene.tools.size());
   for (size_t k = 0; k < scene.tools.size(); ++k) {
     const ToolGrasp* g = scene.world.get<ToolGrasp>(scene.tools[k]);
@@ -101,11 +136,12 @@ void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& c
       held = {};
     }
     const ToolState& st = scene.world.at<ToolState>(scene.tools[k]);
-    if (held.held() || g->capsule.holding() || g->capsule.closed || st.grip < cp.grasp.close_at) continue;
+    if (held.held() || g->capsule.holding() || g->capsule.closed || st.grip < cs.grasp.close_at)
+      continue;
     const cut::CutPoint c =
         cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency, cc.contact_hint, st.pos, cc.cut.snap);
     cc.contact_hint = c.triangle;
-    if (c.distance_mm > cp.grasp.radius_mm) continue;
+    if (c.distance_mm > cs.grasp.radius_mm) continue;
     held = cut::grasp_at(m, c, cc.cut, cc.log);
     if (held.held() && !held.temporary) held = {};  // an existing vertex: nothing to undo
     cc.temporary_vertices += held.temporary;
@@ -197,12 +233,13 @@ bool add_capsule_cutting(Scene& scene) {
   const Entity capsule = *scene.body(BodyPart::Capsule);
   Particles& p = scene.world.at<Particles>(capsule);
   Triangles& tr = scene.world.at<Triangles>(capsule);
-  CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
+  CapsuleSprings& sp = scene.world.at<CapsuleSprings>(capsule);
+  const CapsuleSettings& cs = scene.world.at<CapsuleSettings>(capsule);
   CapsuleCutting cc;
-  cc.material.springs = cp.material;
+  cc.material.springs = cs.material;
   cc.material.areal_density_kg_mm2 =
       scene.params.get("capsule.density_kg_m3") * 1e-9 * scene.params.get("capsule.thickness_mm");
-  cc.topology = cut::build_topology(p, tr, cp.springs);
+  cc.topology = cut::build_topology(p, tr, sp.springs);
   cc.tear.rule = rule == "flap_force" ? tear::TearRule::FlapForce : tear::TearRule::MostStressedSpring;
   double edge = 0.0;
   uint32_t counted = 0;
@@ -216,47 +253,69 @@ bool add_capsule_cutting(Scene& scene) {
   cc.cut.snap.edge_snap_mm = std::min(0.01, 0.05 * edge);
   cc.cut.remesh = false;  // no particle may disappear under the dynamics' feet
   cc.rest_x = p.x, cc.rest_y = p.y, cc.rest_z = p.z;
-  cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
+  cut::CutMesh m{p, tr, sp.springs, cc.topology, cc.material};
   const uint32_t extra = std::max<uint32_t>(4096, p.slots.size() / 4);
   cut::reserve_for_cuts(m, extra);
-  for (auto* v : {&cc.rest_x, &cc.rest_y, &cc.rest_z}) v->reserve(p.slots.size() + extra);
+  for (auto* v : {&cc.rest_x, &cc.rest_y, &cc.rest_z, &sp.glue.x, &sp.glue.y, &sp.glue.z})
+    v->reserve(p.slots.size() + extra);
+  CapsuleSolver& solver = scene.world.at<CapsuleSolver>(capsule);
+  for (auto* v : {&solver.forces.fx, &solver.forces.fy, &solver.forces.fz})
+    v->reserve(p.slots.size() + extra);
+  scene.world.name_component<CapsuleCutting>("cutting");
   scene.world.add(capsule, std::move(cc));
   return true;
 }
 
 SystemDesc capsule_cut_system(Scene& scene) {
   const Entity capsule = *scene.body(BodyPart::Capsule);
-  return {.name = "capsule_cut",
-          .phase = Phase::Topology,
-          .reads = {"tools.pose", "tools.grasp"},
-          .writes = {"capsule.particles", "capsule.triangles", "capsule.physics"},
-          .run = [&scene, capsule](const FrameContext& ctx) {
-            Particles& p = scene.world.at<Particles>(capsule);
-            Triangles& tr = scene.world.at<Triangles>(capsule);
-            CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
-            CapsuleCutting& cc = scene.world.at<CapsuleCutting>(capsule);
-            ++cc.frames;
-            prune_sources(cc, ctx.frame);
-            cut::CutMesh m{p, tr, cp.springs, cc.topology, cc.material};
-            const auto t0 = std::chrono::steady_clock::now();
-            cc.log.clear();
-            forceps_temporary_vertices(scene, m, cc, cp);  // on the deformed capsule, where the forceps are
-            Vec3 cut_at = Vec3::Zero(), pull = Vec3::Zero();
-            const bool cutting = cystotome_contact(scene, m, cc, cut_at);
-            const bool pulling = !cutting && flap_pull(scene, m, cc, pull);
-            if (cutting || pulling) edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull);
-            const double edit_ms = elapsed_ms(t0);
-            cc.edit_ms_total += edit_ms;
-            cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);
-            if (cc.log.touched_triangles.empty() && cc.log.new_particles.empty() && cc.log.opened_edges == 0) return;
-            const auto t1 = std::chrono::steady_clock::now();
-            add_sources(cc, p, ctx.frame);
-            refresh_physics(m, cp, cc.log);
-            const double refresh_ms = elapsed_ms(t1);
-            cc.refresh_ms_total += refresh_ms;
-            cc.refresh_ms_max = std::max(cc.refresh_ms_max, refresh_ms);
-            ++cc.topology_changes;
-          }};
+  return {
+      .name = "capsule_cut",
+      .phase = Phase::Topology,
+      .reads = {"tools.pose", "tools.grasp", "capsule.settings"},
+      .writes = {"capsule.particles", "capsule.triangles", "capsule.springs", "capsule.cutting"},
+      .run = [&scene, capsule](const FrameContext& ctx) {
+        Particles& p = scene.world.at<Particles>(capsule);
+        Triangles& tr = scene.world.at<Triangles>(capsule);
+        CapsuleSprings& sp = scene.world.at<CapsuleSprings>(capsule);
+        const CapsuleSettings& cs = scene.world.at<CapsuleSettings>(capsule);
+        CapsuleCutting& cc = scene.world.at<CapsuleCutting>(capsule);
+        ++cc.frames;
+        prune_sources(cc, ctx.frame);
+        cut::CutMesh m{p, tr, sp.springs, cc.topology, cc.material};
+        const auto t0 = std::chrono::steady_clock::now();
+        cc.log.clear();
+        forceps_temporary_vertices(scene, m, cc,
+                                   cs);  // on the deformed capsule, where the forceps are
+        Vec3 cut_at = Vec3::Zero(), pull = Vec3::Zero();
+        const bool cutting = cystotome_contact(scene, m, cc, cut_at);
+        const bool pulling = !cutting && flap_pull(scene, m, cc, pull);
+        if (cutting || pulling) edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull);
+        const double edit_ms = elapsed_ms(t0);
+        cc.edit_ms_total += edit_ms;
+        cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);
+        const bool changed = !cc.log.touched_triangles.empty() || !cc.log.new_particles.empty() ||
+                             cc.log.opened_edges != 0 || !cc.topology.added_springs.empty() ||
+                             !cc.topology.removed_springs.empty();
+        if (!changed) {
+          // A frame without topology change: the one place for the rare whole-table re-plan.
+          if (compaction_due(sp, cc)) {
+            const auto t2 = std::chrono::steady_clock::now();
+            compact_physics(m, sp);
+            ++cc.compactions;
+            cc.compaction_ms_total += elapsed_ms(t2);
+            check_patched_physics(sp, p.slots.size());
+          }
+          return;
+        }
+        const auto t1 = std::chrono::steady_clock::now();
+        add_sources(cc, p, ctx.frame);
+        refresh_physics(m, sp, cc.log);
+        const double refresh_ms = elapsed_ms(t1);
+        cc.refresh_ms_total += refresh_ms;
+        cc.refresh_ms_max = std::max(cc.refresh_ms_max, refresh_ms);
+        ++cc.topology_changes;
+        check_patched_physics(sp, p.slots.size());
+      }};
 }
 
 nlohmann::json capsule_cutting_summary(Scene& scene) {
@@ -264,29 +323,32 @@ nlohmann::json capsule_cutting_summary(Scene& scene) {
   if (!capsule) return nullptr;
   CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
   if (!cc) return nullptr;
-  CapsulePhysics& cp = scene.world.at<CapsulePhysics>(*capsule);
-  const cut::CutMesh m{scene.world.at<Particles>(*capsule), scene.world.at<Triangles>(*capsule), cp.springs,
-                       cc->topology, cc->material};
+  CapsuleSprings& sp = scene.world.at<CapsuleSprings>(*capsule);
+  const cut::CutMesh m{scene.world.at<Particles>(*capsule), scene.world.at<Triangles>(*capsule),
+                       sp.springs, cc->topology, cc->material};
   const rhexis::Opening o = rhexis::measure_opening(m);
   const tear::TearState& ts = cc->tear_state;
-  nlohmann::json j = {{"cut_segments", cc->cut_segments},
-                      {"topology_changes", cc->topology_changes},
-                      {"tear_rule", std::string(tear::to_string(cc->tear.rule))},
-                      {"tear_steps", ts.steps},
-                      {"tear_advances", ts.advances},
-                      {"tear_complete", ts.complete},
-                      {"runout_warnings", ts.count(tear::TearEvent::RunoutWarning)},
-                      {"radial_tearouts", ts.count(tear::TearEvent::RadialTearout)},
-                      {"max_tear_radius_mm", ts.max_radius_mm},
-                      {"edit_ms_mean_per_frame", cc->frames ? cc->edit_ms_total / double(cc->frames) : 0.0},
-                      {"edit_ms_max", cc->edit_ms_max},
-                      {"physics_refresh_ms_mean",
-                       cc->topology_changes ? cc->refresh_ms_total / double(cc->topology_changes) : 0.0},
-                      {"physics_refresh_ms_max", cc->refresh_ms_max},
-                      {"temporary_grasp_vertices", cc->temporary_vertices},
-                      {"temporary_grasp_vertices_removed", cc->temporary_removed},
-                      {"temporary_grasp_vertices_kept", cc->temporary_kept},
-                      {"opening_complete", o.complete}};
+  nlohmann::json j = {
+      {"cut_segments", cc->cut_segments},
+      {"topology_changes", cc->topology_changes},
+      {"tear_rule", std::string(tear::to_string(cc->tear.rule))},
+      {"tear_steps", ts.steps},
+      {"tear_advances", ts.advances},
+      {"tear_complete", ts.complete},
+      {"runout_warnings", ts.count(tear::TearEvent::RunoutWarning)},
+      {"radial_tearouts", ts.count(tear::TearEvent::RadialTearout)},
+      {"max_tear_radius_mm", ts.max_radius_mm},
+      {"edit_ms_mean_per_frame", cc->frames ? cc->edit_ms_total / double(cc->frames) : 0.0},
+      {"edit_ms_max", cc->edit_ms_max},
+      {"physics_refresh_ms_mean",
+       cc->topology_changes ? cc->refresh_ms_total / double(cc->topology_changes) : 0.0},
+      {"physics_refresh_ms_max", cc->refresh_ms_max},
+      {"compactions", cc->compactions},
+      {"compaction_ms_total", cc->compaction_ms_total},
+      {"temporary_grasp_vertices", cc->temporary_vertices},
+      {"temporary_grasp_vertices_removed", cc->temporary_removed},
+      {"temporary_grasp_vertices_kept", cc->temporary_kept},
+      {"opening_complete", o.complete}};
   nlohmann::json events = nlohmann::json::array();
   for (const tear::TearEvent& e : ts.events)
     events.push_back({{"kind", std::string(tear::to_string(e.kind))}, {"tear_step", e.step},

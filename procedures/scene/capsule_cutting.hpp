@@ -15,10 +15,14 @@
 // (cut::ParticleOrigin) on the current positions.
 //
 // Runs in the topology phase, before the dynamics: it edits the capsule's tables through a
-// CutMesh (local edits), then, if anything changed, brings the physics up to date — the spring
-// table is compacted and sorted again, the spring graph, blocks, glue and scratch arrays are
-// rebuilt for the new particle count (a pass over the whole capsule: see docs/cutting_and_tearing.md
-// for its cost). Remeshing is off in the scene so that no particle is removed.
+// CutMesh (local edits), then, if anything changed, patches the physics (capsule.springs) where
+// the edits touched it: new springs are already in the force blocks' unplanned tail, removed ones
+// are tombstones, the spring graph's rows of their ends are patched, the glue grows for the new
+// particles. Nothing in a cut frame passes over the whole capsule. When the tail and tombstones
+// pass a fraction of the spring table (compact_fraction), the next frame WITHOUT a topology change
+// compacts, sorts and re-plans the springs and rebuilds the graph: a whole-capsule pass, rare and
+// amortised (docs/cutting_and_tearing.md). Remeshing is off in the scene so that no particle is
+// removed by the cut itself.
 //
 // Forceps grasp inside a triangle or on an edge through a temporary vertex (seed 000 Fig. 9,
 // systems/cut/grasp_point): when a forceps closes near the capsule, the point under its tip becomes
@@ -60,7 +64,13 @@ struct CapsuleCutting {
   uint64_t temporary_vertices = 0, temporary_removed = 0, temporary_kept = 0;
   cut::EditLog log;              // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
-  double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics rebuild after changes
+  double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics patch after changes
+  // Deferred compaction: due when tail + tombstones exceed max(compact_min_springs,
+  // compact_fraction × live springs); done in the next frame without topology change.
+  double compact_fraction = 0.125;
+  uint32_t compact_min_springs = 1024;
+  uint64_t compactions = 0;
+  double compaction_ms_total = 0.0;
   double edit_ms_total = 0.0, edit_ms_max = 0.0;        // the local edits themselves
 };
 
@@ -68,8 +78,8 @@ struct CapsuleCutting {
 // capsule.cutting = off; returns whether it did.
 bool add_capsule_cutting(Scene& scene);
 
-// The topology-phase system: reads tools.pose, writes capsule.particles, capsule.triangles and
-// capsule.physics.
+// The topology-phase system. Reads: tools.pose, tools.grasp, capsule.settings. Writes:
+// capsule.particles, capsule.triangles, capsule.springs, capsule.cutting (this component).
 SystemDesc capsule_cut_system(Scene& scene);
 
 // For the run report: cuts, tear events, and the opening if the disc came free.

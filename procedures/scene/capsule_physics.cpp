@@ -59,43 +59,56 @@ void add_capsule_physics(Scene& scene) {
       method_choice(scene, "capsule.pretension", "cotangent", {"cotangent", "uniform_prestretch"});
   const std::string active = method_choice(scene, "capsule.active_set", "on", {"on", "off"});
 
-  CapsulePhysics cp;
-  cp.dynamics.integrator = *parse_integrator(integrator);
-  cp.dynamics.law = law == "quadratic" ? SpringLaw::Quadratic : SpringLaw::Linear;
-  cp.dynamics.damping_per_s = static_cast<float>(params.get("capsule_model.damping_per_s"));
-  cp.dynamics.viscosity_per_s = static_cast<float>(params.get("capsule_model.viscosity_per_s"));
-  cp.dynamics.glue_stiffness_mn_mm = static_cast<float>(params.get("capsule_model.glue_stiffness_mn_mm"));
-  cp.dynamics.gravity_mm_s2 = {0.0f, 0.0f, -static_cast<float>(params.get("capsule_model.gravity_mm_s2"))};
-  cp.use_active_set = active == "on";
-  cp.active_hops = static_cast<uint32_t>(params.get("capsule_model.active_hops"));
-  cp.grasp.radius_mm = params.get("capsule_model.grasp_radius_mm");
-  cp.wake_motion_mm = params.get("capsule_model.wake_motion_mm");
-  cp.wake_force_mn = params.get("capsule_model.wake_force_mn");
+  CapsuleSettings cs;
+  CapsuleSprings sp;
+  cs.dynamics.integrator = *parse_integrator(integrator);
+  cs.dynamics.law = law == "quadratic" ? SpringLaw::Quadratic : SpringLaw::Linear;
+  cs.dynamics.damping_per_s = static_cast<float>(params.get("capsule_model.damping_per_s"));
+  cs.dynamics.viscosity_per_s = static_cast<float>(params.get("capsule_model.viscosity_per_s"));
+  cs.dynamics.glue_stiffness_mn_mm =
+      static_cast<float>(params.get("capsule_model.glue_stiffness_mn_mm"));
+  cs.dynamics.gravity_mm_s2 = {0.0f, 0.0f,
+                               -static_cast<float>(params.get("capsule_model.gravity_mm_s2"))};
+  cs.use_active_set = active == "on";
+  cs.active_hops = static_cast<uint32_t>(params.get("capsule_model.active_hops"));
+  cs.grasp.radius_mm = params.get("capsule_model.grasp_radius_mm");
+  cs.wake_motion_mm = params.get("capsule_model.wake_motion_mm");
+  cs.wake_force_mn = params.get("capsule_model.wake_force_mn");
 
   springs::SpringMaterial material;
-  material.law = cp.dynamics.law;
+  material.law = cs.dynamics.law;
   material.weighting = stiffness == "uniform" ? StiffnessWeighting::Uniform : StiffnessWeighting::AreaWeighted;
   // E [kPa = mN/mm²] × h [mm] = sheet modulus [mN/mm] (systems/springs/springs.hpp).
   material.sheet_modulus_mn_mm = params.get("capsule.youngs_modulus_kpa") * params.get("capsule.thickness_mm");
   material.prestretch = params.get("capsule_model.prestretch");
   material.pretension =
       pretension == "cotangent" ? springs::Pretension::Cotangent : springs::Pretension::UniformPrestretch;
-  cp.material = material;
-  cp.springs = springs::build_springs(particles, triangles, material);
-  cp.blocks = springs::plan_blocks(cp.springs, particles.slots.size());
-  cp.forces.resize_zero(particles.slots.size());
-  cp.glue = Glue{particles.x, particles.y, particles.z};
-  cp.graph = springs::build_spring_graph(cp.springs, particles.slots.size());
+  cs.material = material;
+  sp.springs = springs::build_springs(particles, triangles, material);
+  sp.blocks = springs::plan_blocks(sp.springs, particles.slots.size());
+  sp.glue = Glue{particles.x, particles.y, particles.z};
+  sp.graph = springs::build_spring_graph(sp.springs, particles.slots.size());
+  CapsuleSolver solver;
+  solver.forces.resize_zero(particles.slots.size());
 
-  cp.environment.has_lens = true;
-  cp.environment.lens_radius_mm = 0.5 * params.get("lens.equatorial_diameter_mm");
-  cp.environment.lens_anterior_mm = params.get("lens.anterior_half_thickness_mm");
-  cp.environment.lens_posterior_mm = params.get("lens.posterior_half_thickness_mm");
-  cp.environment.has_cornea = true;
-  cp.environment.cornea_radius_mm = params.get("cornea.posterior_radius_mm");
-  cp.environment.cornea_centre_z_mm = params.get("cornea.posterior_apex_z_mm") - cp.environment.cornea_radius_mm;
+  cs.environment.has_lens = true;
+  cs.environment.lens_radius_mm = 0.5 * params.get("lens.equatorial_diameter_mm");
+  cs.environment.lens_anterior_mm = params.get("lens.anterior_half_thickness_mm");
+  cs.environment.lens_posterior_mm = params.get("lens.posterior_half_thickness_mm");
+  cs.environment.has_cornea = true;
+  cs.environment.cornea_radius_mm = params.get("cornea.posterior_radius_mm");
+  cs.environment.cornea_centre_z_mm =
+      params.get("cornea.posterior_apex_z_mm") - cs.environment.cornea_radius_mm;
 
-  scene.world.add(capsule, std::move(cp));
+  scene.world.name_component<CapsuleSettings>("settings");
+  scene.world.name_component<CapsuleSprings>("springs");
+  scene.world.name_component<CapsuleSolver>("solver");
+  scene.world.name_component<CapsuleStats>("stats");
+  scene.world.name_component<ToolGrasp>("grasp");
+  scene.world.add(capsule, std::move(cs));
+  scene.world.add(capsule, std::move(sp));
+  scene.world.add(capsule, std::move(solver));
+  scene.world.add(capsule, CapsuleStats{});
   for (Entity tool : scene.tools) {
     if (scene.world.at<Tool>(tool).kind == ToolKind::Forceps) scene.world.add(tool, ToolGrasp{});
   }
@@ -105,89 +118,110 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
   const Entity capsule = *scene.body(BodyPart::Capsule);
   return {.name = "capsule_dynamics",
           .phase = Phase::Dynamics,
-          .reads = {"tools.pose"},
-          .writes = {"capsule.particles", "capsule.physics", "tools.grasp"},
+          .reads = {"tools.pose", "capsule.springs", "capsule.settings", "capsule.triangles",
+                    "capsule.cutting"},
+          .writes = {"capsule.particles", "capsule.solver", "capsule.stats", "tools.grasp"},
           .run = [&scene, capsule](const FrameContext& ctx) {
             Particles& p = scene.world.at<Particles>(capsule);
-            CapsulePhysics& cp = scene.world.at<CapsulePhysics>(capsule);
+            const CapsuleSprings& sp = scene.world.at<CapsuleSprings>(capsule);
+            const CapsuleSettings& cs = scene.world.at<CapsuleSettings>(capsule);
+            CapsuleSolver& solver = scene.world.at<CapsuleSolver>(capsule);
+            CapsuleStats& stats = scene.world.at<CapsuleStats>(capsule);
             if constexpr (topology_check::kCheckEveryFrame) {
               // Debug builds check the membrane's structural invariants every frame (issue 4 item 4):
               // edges, orientation, springs = edges, indices, no NaN. The area and angle bounds are
               // zero here: a pulled membrane legitimately squeezes triangles (0.24° seen in the
               // demo); those bounds judge the mesh a cut produces, not the deformed shape.
               static const topology_check::InvariantThresholds kStructuralOnly{0.0, 0.0};
-              const auto report = topology_check::check_membrane(p, scene.world.at<Triangles>(capsule), cp.springs,
-                                                                 kStructuralOnly);
-              if (!report.ok()) throw std::logic_error("capsule invariants broken: " + report.summary());
+              const auto report = topology_check::check_membrane(
+                  p, scene.world.at<Triangles>(capsule), sp.springs, kStructuralOnly);
+              if (!report.ok())
+                throw std::logic_error("capsule invariants broken: " + report.summary());
             }
+            // A cut or tear changed the structure: caches keyed to it are stale, and the force
+            // arrays grow (amortised) to the new particle count.
+            if (solver.springs_version != sp.version) {
+              solver.state.implicit.invalidate();
+              solver.springs_version = sp.version;
+            }
+            solver.forces.grow(p.slots.size());
 
-            // Seeds of the active set: what the forceps hold this frame.
             // Seeds of the active set: what the forceps hold this frame, and the cut's fresh lips (seed
             // 000 §5.2: "the vertices on the cut path ... serving as the starting points of force
             // propagation"), so a cut far from the forceps still opens.
-            std::vector<uint32_t>& seeds = cp.seeds;
+            std::vector<uint32_t>& seeds = solver.seeds;
             seeds.clear();
             for (Entity tool : scene.tools) {
               ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
               if (!g) continue;
               const ToolState& pose = scene.world.at<ToolState>(tool);
-              const grasp::GraspEvent ev = grasp::update_grasp(g->capsule, p, pose.pos, pose.grip, ctx.dt_s, cp.grasp);
-              cp.grasps += ev.grasped;
-              cp.releases += ev.released;
-              cp.missed_grasps += ev.missed;
+              const grasp::GraspEvent ev =
+                  grasp::update_grasp(g->capsule, p, pose.pos, pose.grip, ctx.dt_s, cs.grasp);
+              stats.grasps += ev.grasped;
+              stats.releases += ev.released;
+              stats.missed_grasps += ev.missed;
               if (g->capsule.holding()) seeds.push_back(g->capsule.particle);
             }
 
-            deform::Membrane m{p, cp.springs, cp.blocks, cp.forces, cp.dynamics, &cp.glue, &cp.environment};
-            if (cp.use_active_set) {
+            deform::Membrane m{p,           sp.springs, sp.blocks,      solver.forces,
+                               cs.dynamics, &sp.glue,   &cs.environment};
+            if (cs.use_active_set) {
               active_nodes::WakeInputs wake;
               wake.particles = &p;
               wake.dt_s = ctx.dt_s;
-              wake.springs = &cp.springs;
-              wake.law = cp.dynamics.law;
-              wake.motion_threshold_mm = cp.wake_motion_mm;
-              wake.force_threshold_mn = cp.wake_force_mn;
+              wake.springs = &sp.springs;
+              wake.law = cs.dynamics.law;
+              wake.motion_threshold_mm = cs.wake_motion_mm;
+              wake.force_threshold_mn = cs.wake_force_mn;
               if (const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(capsule)) {
                 for (uint32_t v : cc->sources)
                   if (p.slots.alive(v)) seeds.push_back(v);
               }
-              active_nodes::update_active_set(cp.graph, std::span<const uint32_t>(seeds.data(), seeds.size()),
-                                              cp.active_hops, wake, cp.active);
-              for (uint32_t i : cp.active.fell_asleep) p.vx[i] = p.vy[i] = p.vz[i] = 0.0f;
-              if (cp.active.particles.empty()) return;  // the whole capsule sleeps: nothing to integrate
-              m.active = cp.active.particles;
-              m.active_springs = cp.active.springs;
+              active_nodes::update_active_set(sp.graph,
+                                              std::span<const uint32_t>(seeds.data(), seeds.size()),
+                                              cs.active_hops, wake, solver.active);
+              for (uint32_t i : solver.active.fell_asleep) p.vx[i] = p.vy[i] = p.vz[i] = 0.0f;
+              if (solver.active.particles.empty())
+                return;  // the whole capsule sleeps: nothing to integrate
+              m.active = solver.active.particles;
+              m.active_springs = solver.active.springs;
             }
-            deform::step(m, ctx.dt_s, cp.state);
-            const uint32_t n = cp.use_active_set ? static_cast<uint32_t>(cp.active.particles.size()) : p.slots.size();
-            ++cp.frames_stepped;
-            cp.active_particle_sum += n;
-            cp.active_particle_max = std::max(cp.active_particle_max, n);
+            deform::step(m, ctx.dt_s, solver.state);
+            const uint32_t n = cs.use_active_set
+                                   ? static_cast<uint32_t>(solver.active.particles.size())
+                                   : p.slots.size();
+            ++stats.frames_stepped;
+            stats.active_particle_sum += n;
+            stats.active_particle_max = std::max(stats.active_particle_max, n);
           }};
 }
 
 nlohmann::json capsule_physics_summary(const Scene& scene) {
   const auto capsule = scene.body(BodyPart::Capsule);
   if (!capsule) return nullptr;
-  const CapsulePhysics* cp = scene.world.get<CapsulePhysics>(*capsule);
-  if (!cp) return nullptr;
-  const DynamicsStatus& st = cp->state.status;
-  const double mean_active =
-      cp->frames_stepped ? static_cast<double>(cp->active_particle_sum) / static_cast<double>(cp->frames_stepped) : 0.0;
-  return {{"integrator", std::string(to_string(cp->dynamics.integrator))},
-          {"spring_law", cp->dynamics.law == SpringLaw::Quadratic ? "quadratic" : "linear"},
-          {"active_set", cp->use_active_set},
-          {"springs", cp->springs.slots.live_count()},
-          {"frames_stepped", cp->frames_stepped},
+  const CapsuleSettings* cs = scene.world.get<CapsuleSettings>(*capsule);
+  if (!cs) return nullptr;
+  const CapsuleSprings& sp = *scene.world.get<CapsuleSprings>(*capsule);
+  const CapsuleSolver& solver = *scene.world.get<CapsuleSolver>(*capsule);
+  const CapsuleStats& stats = *scene.world.get<CapsuleStats>(*capsule);
+  const DynamicsStatus& st = solver.state.status;
+  const double mean_active = stats.frames_stepped ? static_cast<double>(stats.active_particle_sum) /
+                                                        static_cast<double>(stats.frames_stepped)
+                                                  : 0.0;
+  return {{"integrator", std::string(to_string(cs->dynamics.integrator))},
+          {"spring_law", cs->dynamics.law == SpringLaw::Quadratic ? "quadratic" : "linear"},
+          {"active_set", cs->use_active_set},
+          {"springs", sp.springs.slots.live_count()},
+          {"frames_stepped", stats.frames_stepped},
           {"active_particles_mean", mean_active},
-          {"active_particles_max", cp->active_particle_max},
+          {"active_particles_max", stats.active_particle_max},
           {"divergences", st.divergences},
           {"fallbacks", st.fallbacks},
           {"max_speed_mm_s", st.max_speed_mm_s},
-          {"cg_iterations_total", cp->state.implicit.stats.cg_iterations_total},
-          {"grasps", cp->grasps},
-          {"releases", cp->releases},
-          {"missed_grasps", cp->missed_grasps}};
+          {"cg_iterations_total", solver.state.implicit.stats.cg_iterations_total},
+          {"grasps", stats.grasps},
+          {"releases", stats.releases},
+          {"missed_grasps", stats.missed_grasps}};
 }
 
 }  // namespace phaco

@@ -33,25 +33,55 @@ namespace phaco {
 
 struct Scene;
 
-struct CapsulePhysics {
-  springs::SpringMaterial material;  // what the springs were built with (cutting re-springs with it)
+// The capsule's physics is four components, each under its own access name, so the frame graph
+// can overlap what does not conflict (Jolt keeps a soft body's shared settings apart from its
+// runtime state in the same way):
+//
+//   capsule.springs   CapsuleSprings   shared structure that changes only with topology: written by
+//                                      the build and the topology phase (capsule_cut), read by the
+//                                      dynamics, the haptic model and the metrics
+//   capsule.solver    CapsuleSolver    per-frame state of the integration: written only by
+//                                      capsule_dynamics
+//   capsule.settings  CapsuleSettings  material, dynamics, grasp and wake settings: read-only
+//                                      after the build
+//   capsule.stats     CapsuleStats     counters for the run report: written by capsule_dynamics
+
+// capsule.springs. A cut or tear patches it (procedures/scene/capsule_cutting.hpp): new springs go
+// to the blocks' tail, the graph's touched rows are patched, glue grows for new particles; a full
+// re-plan happens only in a frame without topology change. `version` counts those changes so the
+// solver can tell its cached structure is stale without the topology phase writing the solver.
+struct CapsuleSprings {
   Springs springs;
   SpringBlocks blocks;
-  Forces forces;
-  Dynamics dynamics;
-  Glue glue;
-  deform::Environment environment;
-  deform::DeformState state;
   SpringGraph graph;
+  Glue glue;             // per particle: the point on the lens its glue spring pulls to, mm
+  uint64_t version = 0;  // +1 whenever springs, blocks or graph change after the build
+};
+
+// capsule.solver.
+struct CapsuleSolver {
+  Forces forces;
+  deform::DeformState state;
   active_nodes::ActiveSet active;
+  std::vector<uint32_t> seeds;   // this frame's active-set seeds (scratch)
+  uint64_t springs_version = 0;  // the CapsuleSprings::version the solver's caches were built for
+};
+
+// capsule.settings.
+struct CapsuleSettings {
+  springs::SpringMaterial
+      material;  // what the springs were built with (cutting re-springs with it)
+  Dynamics dynamics;
+  deform::Environment environment;
   bool use_active_set = true;
   uint32_t active_hops = 8;
   double wake_motion_mm = 1e-3;  // a neighbour moving more than this in a step wakes a sleeper
   double wake_force_mn = 1e-2;   // so does an unbalanced force above this
   grasp::GraspSettings grasp;
-  std::vector<uint32_t> seeds;  // this frame's active-set seeds (scratch)
+};
 
-  // Over the run, for the report.
+// capsule.stats: over the run, for the report.
+struct CapsuleStats {
   uint64_t frames_stepped = 0;
   uint64_t active_particle_sum = 0;
   uint32_t active_particle_max = 0;
@@ -72,10 +102,13 @@ std::string method_choice(const Scene& scene, const std::string& key, const std:
 bool is_capsule_method(const std::string& key);
 
 // Builds the capsule's physics from the scene's parameters and methods (InputError naming the
-// scenario's `methods` field on a bad choice) and adds it to the capsule entity.
+// scenario's `methods` field on a bad choice) and adds its four components to the capsule entity.
 void add_capsule_physics(Scene& scene);
 
-// The frame's system for it: reads tools.pose, writes capsule.particles.
+// The frame's system for it. Reads: tools.pose, capsule.springs, capsule.settings,
+// capsule.triangles (debug builds check the membrane every frame), capsule.cutting (the cut's
+// fresh lips seed the active set). Writes: capsule.particles, capsule.solver, capsule.stats,
+// tools.grasp.
 SystemDesc capsule_dynamics_system(Scene& scene);
 
 // Integrator, counts and averages for the run report.

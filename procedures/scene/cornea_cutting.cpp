@@ -87,6 +87,8 @@ bool add_cornea_cutting(Scene& scene) {
   cc.topology = cut::build_topology(p, tr, cc.springs);
   cut::CutMesh m{p, tr, cc.springs, cc.topology, cc.material};
   cut::reserve_for_cuts(m, std::max<uint32_t>(4096, p.slots.size() / 4));
+  cc.grid = cut::build_triangle_grid(p, tr);
+  scene.world.name_component<CorneaCutting>("cutting");
   scene.world.add(*cornea, std::move(cc));
   return true;
 }
@@ -96,7 +98,7 @@ SystemDesc cornea_cut_system(Scene& scene) {
   return {.name = "cornea_cut",
           .phase = Phase::Topology,
           .reads = {"tools.pose"},
-          .writes = {"cornea.particles", "cornea.triangles"},
+          .writes = {"cornea.particles", "cornea.triangles", "cornea.cutting"},
           .run = [&scene, cornea](const FrameContext&) {
             CorneaCutting& cc = scene.world.at<CorneaCutting>(cornea);
             ++cc.frames;
@@ -115,6 +117,13 @@ SystemDesc cornea_cut_system(Scene& scene) {
             if (cc.cutting && (withdrawing || !now.outer.touches)) {
               end_paths(m, cc);
             } else {
+              // The puncture's start triangle from the grid, so the first contact scans nothing.
+              for (auto [cutter, section] :
+                   {std::pair{&cc.outer, &now.outer}, std::pair{&cc.inner, &now.inner}}) {
+                if (!cutter->started && section->has_puncture)
+                  cutter->start_triangle = cut::nearest_binned_triangle(
+                      cc.grid, m.particles, m.triangles, section->puncture);
+              }
               bool made = corneal_incision::cut_surface(m, cc.outer, now.outer, cc.cut, cc.log,
                                                         cc.segments);
               made = corneal_incision::cut_surface(m, cc.inner, now.inner, cc.cut, cc.log,
@@ -123,6 +132,9 @@ SystemDesc cornea_cut_system(Scene& scene) {
               cc.cutting = cc.outer.started;
               cc.cutting_frames += made;
             }
+            // The cornea has no spring graph to patch (its particles are anchored): drop the
+            // spring changes the edits listed.
+            cc.topology.added_springs.clear(), cc.topology.removed_springs.clear();
             const double ms =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();

@@ -23,8 +23,10 @@
 // outer middle (the angle that sets the tunnel length: ≈ limbal thickness / sin angle); and
 // complete = the blade entered the anterior chamber (the tracker's `penetrated`).
 //
-// Reads: tools.pose. Writes: cornea.particles, cornea.triangles (and its own CorneaCutting record).
-// The cut allocates (paths grow); a frame without a cut does not.
+// Reads: tools.pose. Writes: cornea.particles, cornea.triangles, cornea.cutting (its own
+// CorneaCutting record). The cut allocates (paths grow); a frame without a cut does not. No frame
+// passes over the whole cornea: the puncture's start triangle comes from a grid of the cornea's
+// triangles built at setup (cut::TriangleGrid), not from a scan.
 #include <cstdint>
 
 #include "components/springs.hpp"
@@ -58,6 +60,7 @@ struct CorneaCutting {
   bool have_last_tip = false;
   Vec3 last_tip = Vec3::Zero();
   cut::EditLog log;
+  cut::TriangleGrid grid;  // the uncut cornea's triangles by place: the puncture's start, no scan
   uint64_t frames = 0, cutting_frames = 0, segments = 0;
   double edit_ms_total = 0.0, edit_ms_max = 0.0;
 };
@@ -66,7 +69,8 @@ struct CorneaCutting {
 // whether it did.
 bool add_cornea_cutting(Scene& scene);
 
-// The topology-phase system: reads tools.pose, writes cornea.particles and cornea.triangles.
+// The topology-phase system: reads tools.pose, writes cornea.particles, cornea.triangles and
+// cornea.cutting (this record).
 SystemDesc cornea_cut_system(Scene& scene);
 
 // The incision's metrics and lip series (targets: data/drills/corneal_incision.json)

@@ -102,16 +102,16 @@ DrillRecord* record_of(Scene& scene) {
 }
 
 // |Σ spring forces| on the particle the forceps hold: the flap's pull on the tool, mN.
-double held_pull_mn(const Particles& p, const CapsulePhysics& cp, uint32_t held) {
+double held_pull_mn(const Particles& p, const CapsuleSprings& cp, SpringLaw law, uint32_t held) {
   if (held >= cp.graph.particle_count() || !p.slots.alive(held)) return 0.0;
   const Vec3 x(p.x[held], p.y[held], p.z[held]);
   Vec3 f = Vec3::Zero();
-  for (uint32_t k = cp.graph.offset[held]; k < cp.graph.offset[held + 1]; ++k) {
+  for (uint32_t k = cp.graph.begin(held); k < cp.graph.end(held); ++k) {
     const uint32_t n = cp.graph.neighbour[k], s = cp.graph.spring[k];
     const Vec3 d = Vec3(p.x[n], p.y[n], p.z[n]) - x;
     const double len = d.norm();
     if (len <= 0) continue;
-    const float mag = deform::spring_magnitude(cp.dynamics.law, cp.springs.stiffness[s],
+    const float mag = deform::spring_magnitude(law, cp.springs.stiffness[s],
                                                static_cast<float>(len - cp.springs.rest_length[s]));
     f += static_cast<double>(mag) * (d / len);
   }
@@ -152,8 +152,9 @@ void sample_hand(Scene& scene, DrillRecord& r, int index, double t, double dt_s)
     h.closed = closed, h.holding = holding;
     if (holding) {
       const Entity capsule = *scene.body(BodyPart::Capsule);
-      force = held_pull_mn(scene.world.at<Particles>(capsule),
-                           scene.world.at<CapsulePhysics>(capsule), g->capsule.particle);
+      force =
+          held_pull_mn(scene.world.at<Particles>(capsule), scene.world.at<CapsuleSprings>(capsule),
+                       scene.world.at<CapsuleSettings>(capsule).dynamics.law, g->capsule.particle);
     }
   }
 
@@ -334,7 +335,7 @@ void capsulorhexis_metrics(Scene& scene, const DrillRecord& r, DrillReport& out)
   }
   out.metrics["rhexis.radial_tearouts"] = tearouts;
   out.metrics["runout_warnings"] = warnings;
-  CapsulePhysics& cp = scene.world.at<CapsulePhysics>(*capsule);
+  CapsuleSprings& cp = scene.world.at<CapsuleSprings>(*capsule);
   CapsuleCutting& ccm = scene.world.at<CapsuleCutting>(*capsule);
   const cut::CutMesh m{scene.world.at<Particles>(*capsule), scene.world.at<Triangles>(*capsule),
                        cp.springs, ccm.topology, ccm.material};
@@ -432,27 +433,27 @@ SystemDesc drill_metrics_system(Scene& scene) {
   for (size_t i = 0; i < r.hands.size(); ++i) sample_hand(scene, r, static_cast<int>(i), 0.0, 0.0);
   scene.world.name_component<DrillRecord>("metrics", AccessKind::Global);
   if (!scene.bodies.empty()) scene.world.add(scene.bodies.front(), std::move(r));
-  return {
-      .name = "drill_metrics",
-      .phase = Phase::Metrics,
-      .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.physics", "lens.tets",
-                "tools.ports"},
-      .writes = {"metrics"},
-      .after = {},
-      .run = [&scene](const FrameContext& ctx) {
-        DrillRecord* rec = record_of(scene);
-        if (!rec) return;
-        const double t = ctx.time_s + ctx.dt_s;  // the poses are those at the frame's end
-        rec->t_s.push_back(t);
-        for (size_t i = 0; i < rec->hands.size(); ++i)
-          sample_hand(scene, *rec, static_cast<int>(i), t, ctx.dt_s);
-        sample_tear(scene, *rec, t);
-        // The tool pressing its corneal port beyond the threshold (tool_ports.hpp; ports on only).
-        for (size_t i = 0; i < rec->hands.size(); ++i) {
-          if (double f = 0; port_stress_began(scene, i, f))
-            push_event(*rec, t, "port_stress", static_cast<int>(i), "force_mN", f);
-        }
-      }};
+  return {.name = "drill_metrics",
+          .phase = Phase::Metrics,
+          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.springs",
+                    "capsule.settings", "capsule.cutting", "lens.tets", "tools.ports"},
+          .writes = {"metrics"},
+          .after = {},
+          .run = [&scene](const FrameContext& ctx) {
+            DrillRecord* rec = record_of(scene);
+            if (!rec) return;
+            const double t = ctx.time_s + ctx.dt_s;  // the poses are those at the frame's end
+            rec->t_s.push_back(t);
+            for (size_t i = 0; i < rec->hands.size(); ++i)
+              sample_hand(scene, *rec, static_cast<int>(i), t, ctx.dt_s);
+            sample_tear(scene, *rec, t);
+            // The tool pressing its corneal port beyond the threshold (tool_ports.hpp; ports on
+            // only).
+            for (size_t i = 0; i < rec->hands.size(); ++i) {
+              if (double f = 0; port_stress_began(scene, i, f))
+                push_event(*rec, t, "port_stress", static_cast<int>(i), "force_mN", f);
+            }
+          }};
 }
 
 size_t drill_event_count(Scene& scene) {

@@ -21,7 +21,8 @@
 //              runout_warning, radial_tearout, tear_complete.
 // The system only reads the simulation: the state hash is the same with or without it.
 //
-// Reads: tools.pose, tools.grasp, capsule.particles, capsule.physics, lens.tets. Writes: metrics
+// Reads: tools.pose, tools.grasp, capsule.particles, capsule.springs, capsule.settings,
+// capsule.cutting, lens.tets, tools.ports. Writes: metrics
 // (its own record, kept on the scene's first body: the scene has no drill entity). Per frame it
 // appends to vectors reserved for the scenario's frame count (no allocation in a normal run).
 #include <cstddef>

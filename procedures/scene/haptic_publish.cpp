@@ -55,7 +55,7 @@ uint32_t gather_ball(const SpringGraph& graph, const Particles& p, uint32_t seed
     // The next layer: neighbours of this one not yet local.
     s.next.clear();
     for (uint32_t v : s.layer) {
-      for (uint32_t k = graph.offset[v]; k < graph.offset[v + 1]; ++k) {
+      for (uint32_t k = graph.begin(v); k < graph.end(v); ++k) {
         const uint32_t w = graph.neighbour[k];
         if (w >= p.slots.size() || !p.slots.alive(w) || s.local[w] != kHapticNoNode) continue;
         s.local[w] = 0;  // marked; numbered below
@@ -88,13 +88,12 @@ uint32_t gather_ball(const SpringGraph& graph, const Particles& p, uint32_t seed
 void track_capsule_particles(const Scene& scene, Entity capsule,
                              const HapticPublishSettings& settings, HapticPublishScratch& s) {
   const Particles& p = *scene.world.get<Particles>(capsule);
-  const CapsulePhysics& cp = *scene.world.get<CapsulePhysics>(capsule);
-  if (!cp.use_active_set) return;
+  if (!scene.world.get<CapsuleSettings>(capsule)->use_active_set) return;
   if (s.bins.key_of.empty()) {
     point_bins::bin_all(s.bins, p, 0.5 * settings.contact_radius_mm);
     return;
   }
-  point_bins::rebin(s.bins, p, cp.active.particles);
+  point_bins::rebin(s.bins, p, scene.world.get<CapsuleSolver>(capsule)->active.particles);
   point_bins::bin_appended(s.bins, p);
 }
 
@@ -135,14 +134,15 @@ void gather_patch(const Particles& p, const Triangles& tris, const CapsuleCuttin
 void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSettings& settings,
                   HapticPublishScratch& s, const Vec3& tip, uint32_t grasped, HapticTool& t) {
   const Particles& p = *scene.world.get<Particles>(capsule);
-  const CapsulePhysics& cp = *scene.world.get<CapsulePhysics>(capsule);
+  const CapsuleSprings& cp = *scene.world.get<CapsuleSprings>(capsule);
   const Triangles& tris = *scene.world.get<Triangles>(capsule);
   const SpringGraph& graph = cp.graph;
   const uint32_t n = std::min(p.slots.size(), graph.particle_count());
   uint32_t seed = grasped;
   if (seed == kInvalidIndex || seed >= n)
-    seed = cp.use_active_set ? point_bins::nearest(s.bins, p, tip, settings.contact_radius_mm)
-                             : nearest_by_scan(p, n, tip, settings.contact_radius_mm);
+    seed = scene.world.get<CapsuleSettings>(capsule)->use_active_set
+               ? point_bins::nearest(s.bins, p, tip, settings.contact_radius_mm)
+               : nearest_by_scan(p, n, tip, settings.contact_radius_mm);
   if (seed == kInvalidIndex || seed >= n) return;
 
   if (s.local.size() < p.slots.size()) s.local.resize(p.slots.size(), kHapticNoNode);
@@ -169,7 +169,7 @@ void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSetting
   // Springs between local nodes with at least one free end, each once (from its lower local end).
   for (uint32_t l = 0; l < t.node_count && t.spring_count < kHapticMaxSprings; ++l) {
     const uint32_t v = s.nodes[l];
-    for (uint32_t k = graph.offset[v]; k < graph.offset[v + 1]; ++k) {
+    for (uint32_t k = graph.begin(v); k < graph.end(v); ++k) {
       const uint32_t w = graph.neighbour[k];
       const uint16_t lw = s.local[w];
       if (lw == kHapticNoNode || lw <= l) continue;
@@ -240,7 +240,7 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
   for (HapticTool& t : model.tools) clear_tool(t);
 
   const auto capsule = scene.body(BodyPart::Capsule);
-  const bool has_capsule_physics = capsule && scene.world.get<CapsulePhysics>(*capsule);
+  const bool has_capsule_physics = capsule && scene.world.get<CapsuleSprings>(*capsule);
   const bool has_lens = scene.body(BodyPart::Lens) || scene.body(BodyPart::LensSurface);
   if (has_capsule_physics) track_capsule_particles(scene, *capsule, settings, scratch);
   for (Entity e : scene.tools) {
@@ -280,8 +280,8 @@ SystemDesc haptic_publish_system(Scene& scene) {
   auto scratch = std::make_shared<HapticPublishScratch>();
   return {.name = "publish_haptics",
           .phase = Phase::Publish,
-          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.physics",
-                    "capsule.triangles", "capsule.cutting"},
+          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.springs",
+                    "capsule.solver", "capsule.settings", "capsule.triangles", "capsule.cutting"},
           .writes = {"haptics.model"},
           .run = [&scene, settings, scratch](const FrameContext&) {
             HapticModel& slot = scene.haptics->model_slot();

@@ -18,8 +18,9 @@
 // radius, a breadth-first walk of the ball and of its triangle fans, and a ≈ 62 KiB model write:
 // what the tools touch, not the mesh (issue 17). Whole scans remain where there is no locality to
 // keep: the first frame's binning, a capsule without an active set, and, with capsule.cutting off,
-// the patch (no vertex-to-triangle index). Reads: tools.pose, tools.grasp,
-// capsule.particles, capsule.physics, capsule.triangles. Writes: haptics.model.
+// the patch (no vertex-to-triangle index). Reads: tools.pose, tools.grasp, capsule.particles,
+// capsule.springs, capsule.solver (the active set), capsule.settings, capsule.triangles,
+// capsule.cutting. Writes: haptics.model.
 #include <cstdint>
 #include <vector>
 

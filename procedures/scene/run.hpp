@@ -12,7 +12,7 @@ namespace phaco {
 
 struct SystemCost {
   std::string name;
-  double p50_ms = 0, p99_ms = 0, mean_ms = 0;
+  double p50_ms = 0, p99_ms = 0, mean_ms = 0, max_ms = 0;
 };
 
 struct RunReport {

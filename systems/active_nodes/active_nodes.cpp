@@ -19,7 +19,7 @@ double net_force_sq(const SpringGraph& g, const WakeInputs& w, uint32_t p) {
   const Springs& s = *w.springs;
   double fx = 0.0, fy = 0.0, fz = 0.0;
   if (w.external && p < w.external->fx.size()) fx = w.external->fx[p], fy = w.external->fy[p], fz = w.external->fz[p];
-  for (uint32_t k = g.offset[p]; k < g.offset[p + 1]; ++k) {
+  for (uint32_t k = g.begin(p); k < g.end(p); ++k) {
     const uint32_t q = g.neighbour[k], e = g.spring[k];
     const double dx = double(x.x[q]) - x.x[p], dy = double(x.y[q]) - x.y[p], dz = double(x.z[q]) - x.z[p];
     const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -44,10 +44,20 @@ void clear_active_set(ActiveSet& set) {
 void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds, uint32_t k_hops,
                        const WakeInputs& wake, ActiveSet& set) {
   const uint32_t n = graph.particle_count();
-  if (set.mark.size() != n) {  // first use or a new topology: the only O(n) work
-    set.mark.assign(n, 0);
-    set.previous.assign(n, 0);
+  if (set.mark.size() != n) {
+    // First use, or a cut changed the particle count: the set starts afresh from the seeds (as it
+    // always has after a topology change). The marks are cleared through the list that set them
+    // and grow for the new particles (amortised, with room left at first use): no pass over the
+    // body.
+    for (uint32_t p : set.particles)
+      if (p < set.mark.size()) set.mark[p] = 0;
     set.particles.clear();
+    if (set.mark.capacity() < n) {
+      set.mark.reserve(size_t{n} + n / 4 + 64);
+      set.previous.reserve(size_t{n} + n / 4 + 64);
+    }
+    set.mark.resize(n, 0);
+    set.previous.resize(n, 0);
   }
   // Last update's set becomes `previous`; marks are cleared through it.
   set.previous_list.assign(set.particles.begin(), set.particles.end());
@@ -67,7 +77,7 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
   for (size_t head = 0; head < set.queue.size(); ++head) {
     const uint32_t p = set.queue[head], h = set.hops[head];
     if (h >= k_hops) continue;
-    for (uint32_t k = graph.offset[p]; k < graph.offset[p + 1]; ++k) {
+    for (uint32_t k = graph.begin(p); k < graph.end(p); ++k) {
       const uint32_t q = graph.neighbour[k];
       if (set.mark[q]) continue;
       set.mark[q] = 1;
@@ -91,7 +101,7 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
     const bool moved = wake.particles && speed_sq(*wake.particles, p) * wake.dt_s * wake.dt_s > motion_sq;
     const bool loaded = force_rule && net_force_sq(graph, wake, p) > load_sq;
     if (moved || loaded) activate(p);
-    for (uint32_t k = graph.offset[p]; k < graph.offset[p + 1]; ++k) {
+    for (uint32_t k = graph.begin(p); k < graph.end(p); ++k) {
       const uint32_t q = graph.neighbour[k];
       if (moved) {
         activate(q);
@@ -110,7 +120,8 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
 
   set.spring_scratch.clear();
   for (uint32_t p : set.particles)
-    for (uint32_t k = graph.offset[p]; k < graph.offset[p + 1]; ++k) set.spring_scratch.push_back(graph.spring[k]);
+    for (uint32_t k = graph.begin(p); k < graph.end(p); ++k)
+      set.spring_scratch.push_back(graph.spring[k]);
   std::sort(set.spring_scratch.begin(), set.spring_scratch.end());
   const auto last = std::unique(set.spring_scratch.begin(), set.spring_scratch.end());
   set.springs.assign(set.spring_scratch.begin(), last);

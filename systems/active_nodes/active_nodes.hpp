@@ -32,7 +32,10 @@
 
 namespace phaco::active_nodes {
 
-// The spring graph (components/springs.hpp) comes from springs::build_spring_graph.
+// The spring graph (components/springs.hpp) comes from springs::build_spring_graph and, after a
+// cut or tear, springs::patch_spring_graph. A graph with another particle count than the last
+// update's (a cut added some) restarts the set from the seeds, as a first use does; its marks are
+// cleared through the old set and grown for the new particles, never reset over the whole body.
 
 struct WakeInputs {
   // Positions and velocities after the last step; null: no wake rules (only the seeds' ball).

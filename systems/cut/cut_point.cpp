@@ -283,4 +283,76 @@ double exit_parameter(const Vec3& from, const Vec3& target, int& exit) {
   return s;
 }
 
+TriangleGrid build_triangle_grid(const Particles& p, const Triangles& tr) {
+  TriangleGrid g;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  double edge_sum = 0.0;
+  uint32_t live = 0;
+  for (uint32_t t = 0; t < tr.slots.size(); ++t) {
+    if (!tr.slots.alive(t)) continue;
+    const Vec3 a = particle_position(p, tr.a[t]), b = particle_position(p, tr.b[t]),
+               c = particle_position(p, tr.c[t]);
+    lo = lo.cwiseMin(a).cwiseMin(b).cwiseMin(c), hi = hi.cwiseMax(a).cwiseMax(b).cwiseMax(c);
+    edge_sum += (b - a).norm() + (c - b).norm() + (a - c).norm();
+    ++live;
+  }
+  if (live == 0) return g;
+  g.cell_mm = std::max(2.0 * edge_sum / (3.0 * live), 1e-6);
+  g.origin = lo;
+  for (int k = 0; k < 3; ++k)
+    g.dims[k] =
+        static_cast<uint32_t>(std::min(1024.0, std::floor((hi[k] - lo[k]) / g.cell_mm) + 1.0));
+  const auto cell_of = [&](const Vec3& x) {
+    uint32_t c[3];
+    for (int k = 0; k < 3; ++k)
+      c[k] = static_cast<uint32_t>(
+          std::clamp((x[k] - g.origin[k]) / g.cell_mm, 0.0, double(g.dims[k] - 1)));
+    return (size_t{c[2]} * g.dims[1] + c[1]) * g.dims[0] + c[0];
+  };
+  const size_t cells = size_t{g.dims[0]} * g.dims[1] * g.dims[2];
+  g.cell_begin.assign(cells + 1, 0);
+  std::vector<size_t> cell(tr.slots.size(), cells);
+  for (uint32_t t = 0; t < tr.slots.size(); ++t) {
+    if (!tr.slots.alive(t)) continue;
+    cell[t] = cell_of((particle_position(p, tr.a[t]) + particle_position(p, tr.b[t]) +
+                       particle_position(p, tr.c[t])) /
+                      3.0);
+    ++g.cell_begin[cell[t] + 1];
+  }
+  for (size_t c = 0; c < cells; ++c) g.cell_begin[c + 1] += g.cell_begin[c];
+  g.triangles.resize(g.cell_begin.back());
+  std::vector<uint32_t> fill(g.cell_begin.begin(), g.cell_begin.end() - 1);
+  for (uint32_t t = 0; t < tr.slots.size(); ++t)  // in index order: each cell's list is sorted
+    if (cell[t] < cells) g.triangles[fill[cell[t]]++] = t;
+  return g;
+}
+
+uint32_t nearest_binned_triangle(const TriangleGrid& g, const Particles& p, const Triangles& tr,
+                                 const Vec3& point) {
+  if (g.cell_begin.empty()) return kInvalidIndex;
+  int c[3];
+  for (int k = 0; k < 3; ++k) {
+    const double f = std::floor((point[k] - g.origin[k]) / g.cell_mm);
+    if (f < -1.0 || f > double(g.dims[k])) return kInvalidIndex;
+    c[k] = static_cast<int>(f);
+  }
+  uint32_t best = kInvalidIndex;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (int z = c[2] - 1; z <= c[2] + 1; ++z)
+    for (int y = c[1] - 1; y <= c[1] + 1; ++y)
+      for (int x = c[0] - 1; x <= c[0] + 1; ++x) {
+        if (x < 0 || y < 0 || z < 0 || x >= int(g.dims[0]) || y >= int(g.dims[1]) ||
+            z >= int(g.dims[2]))
+          continue;
+        const size_t cell = (size_t(z) * g.dims[1] + size_t(y)) * g.dims[0] + size_t(x);
+        for (uint32_t k = g.cell_begin[cell]; k < g.cell_begin[cell + 1]; ++k) {
+          const uint32_t t = g.triangles[k];
+          if (!tr.slots.alive(t)) continue;
+          const double d = closest_on(p, tr, t, point).distance;
+          if (d < best_d || (d == best_d && t < best)) best_d = d, best = t;
+        }
+      }
+  return best;
+}
+
 }  // namespace phaco::cut

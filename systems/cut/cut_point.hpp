@@ -59,6 +59,28 @@ CutPoint locate_cut_point(const Particles& particles, const Triangles& triangles
                           const TriangleAdjacency& adjacency, uint32_t start_triangle,
                           const Vec3& point, const SnapSettings& snap);
 
+// Triangles binned by centroid in a uniform grid, built once (O(n), at scene setup) so that the
+// first contact of a tool — where there is no walk hint yet — finds its start triangle from the
+// few cells round the point instead of scanning every triangle inside a frame. Triangles a cut
+// adds later are not binned; the grid only seeds locate_cut_point's walk.
+struct TriangleGrid {
+  Vec3 origin = Vec3::Zero();
+  double cell_mm = 1.0;
+  std::array<uint32_t, 3> dims{0, 0, 0};
+  std::vector<uint32_t>
+      cell_begin;  // per cell + 1: triangles of cell c are [cell_begin[c], cell_begin[c+1])
+  std::vector<uint32_t> triangles;
+};
+
+// Cells about twice the mean edge length.
+TriangleGrid build_triangle_grid(const Particles& particles, const Triangles& triangles);
+
+// The alive binned triangle nearest `point` (by the distance to its closest point, lowest index
+// on ties) among the cells within one cell of the point's; kInvalidIndex if those are empty or
+// the point is outside the grid's box by more than a cell (callers then fall back to the scan).
+uint32_t nearest_binned_triangle(const TriangleGrid& grid, const Particles& particles,
+                                 const Triangles& triangles, const Vec3& point);
+
 // Live triangles around `vertex` reachable from `triangle` (which must hold it) across edges
 // through the vertex, sorted by index. Cleared first; no allocation once `out` has capacity.
 void vertex_fan(const Triangles& triangles, const TriangleAdjacency& adjacency, uint32_t triangle,

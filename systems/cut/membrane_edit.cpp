@@ -81,7 +81,7 @@ uint32_t add_particle(CutMesh& m, uint32_t from, uint32_t other, double w) {
 void add_spring(CutMesh& m, uint32_t a, uint32_t b) {
   const uint64_t key = edge_key(a, b);
   if (m.topology.spring_of_edge.count(key)) return;
-  const uint32_t s = table_add(m.springs);
+  const uint32_t s = table_append(m.springs, 1);  // never a freed slot: see MembraneTopology
   m.springs.i[s] = std::min(a, b);
   m.springs.j[s] = std::max(a, b);
   // Provisional: refresh_region sets both from the rest shape.
@@ -89,12 +89,15 @@ void add_spring(CutMesh& m, uint32_t a, uint32_t b) {
   m.springs.rest_length[s] = static_cast<float>((1.0 - m.material.springs.prestretch) * d.norm());
   m.springs.stiffness[s] = 0.0f;
   m.topology.spring_of_edge.emplace(key, s);
+  m.topology.added_springs.push_back(s);
 }
 
 void remove_spring(CutMesh& m, uint32_t a, uint32_t b) {
   const auto it = m.topology.spring_of_edge.find(edge_key(a, b));
   if (it == m.topology.spring_of_edge.end()) return;
   table_remove(m.springs, it->second);
+  m.springs.stiffness[it->second] = 0.0f;  // a tombstone pulls nothing in passes that skip no slot
+  m.topology.removed_springs.push_back(it->second);
   m.topology.spring_of_edge.erase(it);
 }
 
@@ -227,6 +230,8 @@ void reserve_for_cuts(CutMesh& m, uint32_t extra) {
   g.vertex_triangle.reserve(np);
   g.rest_x.reserve(np), g.rest_y.reserve(np), g.rest_z.reserve(np);
   g.spring_of_edge.reserve(ns);
+  g.added_springs.reserve(3 * size_t{extra});
+  g.removed_springs.reserve(3 * size_t{extra});
 }
 
 void triangles_on_edge(const CutMesh& m, uint32_t a, uint32_t b, std::vector<uint32_t>& out) {

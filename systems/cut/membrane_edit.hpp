@@ -10,7 +10,10 @@
 // the triangle adjacency, a per-particle triangle hint and the spring-per-edge index up to date
 // by hand, and never scans a whole table, so its cost does not grow with the mesh.
 //
-// Springs keep the spring set equal to the edge set (systems/topology_check). Their stiffness and
+// Springs keep the spring set equal to the edge set (systems/topology_check). New springs are
+// appended to the table (the unplanned tail of components/springs.hpp's SpringBlocks); a removed
+// spring is a tombstone whose stiffness is set to 0, so a force pass over the table that does not
+// test liveness adds nothing for it. Their stiffness and
 // rest length, and the particles' lumped masses, are recomputed for the touched region from the
 // membrane's rest shape by the same formulas build_springs uses (seed 000 §5.1 area-weighted
 // stiffness, pre-stretch), so a cut region carries the springs a fresh build of the cut mesh would
@@ -44,6 +47,11 @@ struct MembraneTopology {
   std::vector<uint32_t> vertex_triangle;                  // per particle slot: an alive triangle holding it
   std::unordered_map<uint64_t, uint32_t> spring_of_edge;  // edge_key(i, j) -> spring
   std::vector<double> rest_x, rest_y, rest_z;             // per particle slot: rest shape, mm
+  // Springs the edits added and removed since the owner of the physics last caught up (it clears
+  // them): the spring graph is patched from these, not rebuilt (springs::patch_spring_graph).
+  // Added springs are appended to the table, never put in a freed slot, so a spring index is not
+  // reused before the next compaction (compact_and_sort_springs clears both lists).
+  std::vector<uint32_t> added_springs, removed_springs;
 };
 
 inline uint64_t edge_key(uint32_t i, uint32_t j) {

@@ -20,6 +20,8 @@ void compact_and_sort_springs(CutMesh& m) {
     for (uint32_t k = 0; k < n; ++k) col[k] = copy[order[k]];
   };
   permute(s.i), permute(s.j), permute(s.rest_length), permute(s.stiffness);
+  m.topology.added_springs.clear();  // indices changed: the physics is rebuilt from the table
+  m.topology.removed_springs.clear();
   m.topology.spring_of_edge.clear();
   for (uint32_t k = 0; k < n; ++k) m.topology.spring_of_edge.emplace(edge_key(s.i[k], s.j[k]), k);
 }

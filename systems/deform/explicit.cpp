@@ -105,6 +105,7 @@ void sum_axial_stiffness(const Membrane& m, std::vector<float>& kappa) {
         }
       });
     }
+    for (uint32_t e = blocks.tail_begin(); e < m.springs.slots.size(); ++e) add_axial(m, e, kappa);
     return;
   }
   for (const uint32_t i : m.active) kappa[i] = glue;

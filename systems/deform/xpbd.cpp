@@ -110,6 +110,7 @@ Motion xpbd_step(Membrane& m, double dt_s, XpbdScratch& sc) {
           }
         });
       }
+      for (uint32_t e = blocks.tail_begin(); e < ns; ++e) proj.project(e, sc.lambda);
     }
     if (!glue) continue;
     parallel_for(0u, set.size(), kParticleGrain, [&](uint32_t begin, uint32_t end, int) {

@@ -19,7 +19,7 @@ NodeState node_state(const Particles& p, const Springs& s, SpringLaw law, const 
                      uint32_t i) {
   NodeState st{Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()};
   const Eigen::Vector3d xi(p.x[i], p.y[i], p.z[i]);
-  for (uint32_t r = g.offset[i]; r < g.offset[i + 1]; ++r) {
+  for (uint32_t r = g.begin(i); r < g.end(i); ++r) {
     const uint32_t j = g.neighbour[r], e = g.spring[r];
     const Eigen::Vector3d d = Eigen::Vector3d(p.x[j], p.y[j], p.z[j]) - xi;
     const double l = d.norm();
@@ -60,7 +60,7 @@ bool expand_layer(const SpringGraph& g, PropagationScratch& sc, int layer) {
   const uint32_t from = sc.layer_begin[layer - 1], to = sc.layer_begin[layer];
   for (uint32_t o = from; o < to; ++o) {
     const uint32_t v = sc.order[o];
-    for (uint32_t r = g.offset[v]; r < g.offset[v + 1]; ++r) {
+    for (uint32_t r = g.begin(v); r < g.end(v); ++r) {
       const uint32_t w = g.neighbour[r];
       if (sc.layer_of[w] >= 0) continue;
       sc.layer_of[w] = layer;

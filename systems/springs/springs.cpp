@@ -98,20 +98,33 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
 
 SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count) {
   SpringGraph g;
-  g.offset.assign(static_cast<size_t>(particle_count) + 1, 0);
+  g.row_size.assign(particle_count, 0);
   const uint32_t ns = springs.slots.size();
   for (uint32_t e = 0; e < ns; ++e) {
     if (!springs.slots.alive(e)) continue;
     if (springs.i[e] >= particle_count || springs.j[e] >= particle_count)
       throw std::invalid_argument("build_spring_graph: spring " + std::to_string(e) + " names a particle beyond " +
                                   std::to_string(particle_count));
-    ++g.offset[springs.i[e] + 1];
-    ++g.offset[springs.j[e] + 1];
+    ++g.row_size[springs.i[e]];
+    ++g.row_size[springs.j[e]];
   }
-  for (uint32_t p = 0; p < particle_count; ++p) g.offset[p + 1] += g.offset[p];
-  g.neighbour.resize(g.offset.back());
-  g.spring.resize(g.offset.back());
-  std::vector<uint32_t> fill(g.offset.begin(), g.offset.end() - 1);
+  // Room for the particles and row moves that cuts add, so a cut frame does not reallocate (and
+  // copy) per-particle arrays the size of the mesh; beyond that they grow geometrically.
+  const size_t room = size_t{particle_count} + particle_count / 4 + 64;
+  g.row_begin.reserve(room), g.row_size.reserve(room), g.row_capacity.reserve(room);
+  g.row_begin.resize(particle_count);
+  g.row_capacity.resize(particle_count);
+  uint32_t at = 0;
+  for (uint32_t p = 0; p < particle_count; ++p) {
+    g.row_begin[p] = at;
+    g.row_capacity[p] = g.row_size[p] + kGraphRowSlack;
+    at += g.row_capacity[p];
+  }
+  // Room for rows that move when they outgrow their slack, so the first cuts do not reallocate.
+  g.neighbour.reserve(at + at / 4 + 512), g.spring.reserve(at + at / 4 + 512);
+  g.neighbour.assign(at, kInvalidIndex);
+  g.spring.assign(at, kInvalidIndex);
+  std::vector<uint32_t> fill(g.row_begin);
   for (uint32_t e = 0; e < ns; ++e) {
     if (!springs.slots.alive(e)) continue;
     const uint32_t a = springs.i[e], b = springs.j[e];
@@ -122,14 +135,91 @@ SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count) 
   std::vector<std::pair<uint32_t, uint32_t>> row;
   for (uint32_t p = 0; p < particle_count; ++p) {
     row.clear();
-    for (uint32_t k = g.offset[p]; k < g.offset[p + 1]; ++k) row.emplace_back(g.neighbour[k], g.spring[k]);
+    for (uint32_t k = g.begin(p); k < g.end(p); ++k) row.emplace_back(g.neighbour[k], g.spring[k]);
     std::sort(row.begin(), row.end());
-    for (uint32_t k = g.offset[p]; k < g.offset[p + 1]; ++k) {
-      g.neighbour[k] = row[k - g.offset[p]].first;
-      g.spring[k] = row[k - g.offset[p]].second;
+    for (uint32_t k = g.begin(p); k < g.end(p); ++k) {
+      g.neighbour[k] = row[k - g.begin(p)].first;
+      g.spring[k] = row[k - g.begin(p)].second;
     }
   }
   return g;
+}
+
+namespace {
+
+// Puts (q, e) into p's row at its sorted place; a full row first moves to the end of the arrays
+// with twice the room (amortised: the arrays grow geometrically).
+void row_insert(SpringGraph& g, uint32_t p, uint32_t q, uint32_t e) {
+  for (uint32_t k = g.begin(p); k < g.end(p); ++k)
+    if (g.spring[k] == e) return;  // already there
+  if (g.row_size[p] == g.row_capacity[p]) {
+    const uint32_t from = g.row_begin[p], size = g.row_size[p];
+    const uint32_t capacity = std::max<uint32_t>(2 * size, 4);
+    const uint32_t to = static_cast<uint32_t>(g.neighbour.size());
+    g.neighbour.resize(to + capacity, kInvalidIndex);
+    g.spring.resize(to + capacity, kInvalidIndex);
+    std::copy_n(g.neighbour.begin() + from, size, g.neighbour.begin() + to);
+    std::copy_n(g.spring.begin() + from, size, g.spring.begin() + to);
+    g.row_begin[p] = to;
+    g.row_capacity[p] = capacity;
+  }
+  uint32_t k = g.end(p);
+  for (; k > g.begin(p) &&
+         (g.neighbour[k - 1] > q || (g.neighbour[k - 1] == q && g.spring[k - 1] > e));
+       --k) {
+    g.neighbour[k] = g.neighbour[k - 1];
+    g.spring[k] = g.spring[k - 1];
+  }
+  g.neighbour[k] = q, g.spring[k] = e;
+  ++g.row_size[p];
+}
+
+void row_erase(SpringGraph& g, uint32_t p, uint32_t e) {
+  if (p >= g.particle_count()) return;
+  const uint32_t end = g.end(p);
+  for (uint32_t k = g.begin(p); k < end; ++k) {
+    if (g.spring[k] != e) continue;
+    std::copy(g.neighbour.begin() + k + 1, g.neighbour.begin() + end, g.neighbour.begin() + k);
+    std::copy(g.spring.begin() + k + 1, g.spring.begin() + end, g.spring.begin() + k);
+    --g.row_size[p];
+    return;
+  }
+}
+
+}  // namespace
+
+void patch_spring_graph(SpringGraph& g, const Springs& springs, uint32_t particle_count,
+                        std::span<const uint32_t> removed, std::span<const uint32_t> added) {
+  // New rows start empty with a little room at the end of the arrays (a cut point gets about six
+  // springs); per-particle arrays grow geometrically.
+  constexpr uint32_t kNewRowCapacity = 8;
+  for (uint32_t p = g.particle_count(); p < particle_count; ++p) {
+    g.row_begin.push_back(static_cast<uint32_t>(g.neighbour.size()));
+    g.row_size.push_back(0);
+    g.row_capacity.push_back(kNewRowCapacity);
+    g.neighbour.resize(g.neighbour.size() + kNewRowCapacity, kInvalidIndex);
+    g.spring.resize(g.spring.size() + kNewRowCapacity, kInvalidIndex);
+  }
+  for (uint32_t e : removed) {
+    if (e >= springs.slots.size()) continue;
+    row_erase(g, springs.i[e], e);
+    row_erase(g, springs.j[e], e);
+  }
+  for (uint32_t e : added) {
+    if (!springs.slots.alive(e)) continue;  // added and removed again since the last patch
+    const uint32_t a = springs.i[e], b = springs.j[e];
+    if (a >= particle_count || b >= particle_count)
+      throw std::invalid_argument("patch_spring_graph: spring " + std::to_string(e) +
+                                  " names a particle beyond " + std::to_string(particle_count));
+    row_insert(g, a, b, e);
+    row_insert(g, b, a, e);
+  }
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> graph_row(const SpringGraph& g, uint32_t p) {
+  std::vector<std::pair<uint32_t, uint32_t>> row;
+  for (uint32_t k = g.begin(p); k < g.end(p); ++k) row.emplace_back(g.neighbour[k], g.spring[k]);
+  return row;
 }
 
 SpringBlocks plan_blocks(const Springs& s, uint32_t particle_count, uint32_t target_blocks) {
@@ -231,6 +321,8 @@ void add_spring_forces(const Springs& s, const SpringBlocks& blocks, SpringLaw l
       }
     });
   }
+  spring_range(s, blocks.tail_begin(), s.slots.size(), law, p,
+               f);  // what cuts added since the plan
 }
 
 double spring_energy(const Springs& s, SpringLaw law, const Particles& p) {

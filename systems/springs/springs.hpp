@@ -21,6 +21,8 @@
 //
 // Reads: particles (x, y, z), triangles. Writes: springs; forces (accumulated).
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "components/particles.hpp"
 #include "components/springs.hpp"
@@ -62,16 +64,30 @@ SpringConstants edge_spring_constants(const SpringMaterial& material, double len
 Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& material);
 
 // Both directions of every alive spring, rows sorted by neighbour (independent of the spring
-// table's order). Throws std::invalid_argument if a spring names a particle ≥ particle_count.
+// table's order), each row with room for kGraphRowSlack more entries. Throws
+// std::invalid_argument if a spring names a particle ≥ particle_count.
+inline constexpr uint32_t kGraphRowSlack = 2;
 SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count);
+
+// Patches the graph after a cut or tear instead of rebuilding it: rows for particles up to
+// particle_count (new rows empty), `removed` springs (tombstones; ends read from the table)
+// taken out of their ends' rows, `added` springs that are still alive put in. Costs what the
+// lists name, plus amortised growth of the arrays. Spring indices must not have been reused
+// since they were added (the cut appends springs, components/springs.hpp). The result has the
+// same rows, as sets, as build_spring_graph on the table (and the same order within each row).
+void patch_spring_graph(SpringGraph& graph, const Springs& springs, uint32_t particle_count,
+                        std::span<const uint32_t> removed, std::span<const uint32_t> added);
+
+// Row p as a list of (neighbour, spring), in row order.
+std::vector<std::pair<uint32_t, uint32_t>> graph_row(const SpringGraph& graph, uint32_t p);
 
 // Partition for the parallel force pass; `target_blocks` is a mesh-size choice (e.g. 64), never
 // the thread count. Falls back to fewer (at worst one) blocks when springs span far in index.
 SpringBlocks plan_blocks(const Springs& springs, uint32_t particle_count, uint32_t target_blocks = 64);
 
 // Adds every spring's force to both ends: f_i += F·x̂, f_j −= F·x̂ with x̂ from i to j and
-// F = k·(l − l0) (linear) or k·(l − l0)·|l − l0| (quadratic). Parallel over even then odd blocks;
-// bit-identical for any thread count.
+// F = k·(l − l0) (linear) or k·(l − l0)·|l − l0| (quadratic). Parallel over even then odd blocks,
+// then the unplanned tail serially; bit-identical for any thread count.
 void add_spring_forces(const Springs& springs, const SpringBlocks& blocks, SpringLaw law,
                        const Particles& particles, Forces& forces);
 

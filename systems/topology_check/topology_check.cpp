@@ -456,4 +456,60 @@ InvariantReport check_membrane(const Particles& particles, const Triangles& tria
   return check_membrane(particles, triangles, springs, thresholds, scratch);
 }
 
+std::string check_spring_structure(const Springs& s, const SpringBlocks& blocks,
+                                   const SpringGraph& g, uint32_t particle_count) {
+  const uint32_t ns = s.slots.size(), nb = blocks.count();
+  if (blocks.spring_begin.size() != blocks.particle_begin.size())
+    return "blocks: spring and particle ranges differ in count";
+  if (nb > 0 && blocks.spring_begin.front() != 0)
+    return "blocks: the first block does not start at spring 0";
+  for (uint32_t b = 0; b < nb; ++b)
+    if (blocks.spring_begin[b] > blocks.spring_begin[b + 1] ||
+        blocks.particle_begin[b] > blocks.particle_begin[b + 1])
+      return format("blocks: block %u's range runs backwards", b);
+  if (blocks.tail_begin() > ns)
+    return format("blocks: tail starts at %u beyond %u springs", blocks.tail_begin(), ns);
+  for (uint32_t b = 0; b < nb && nb > 2; ++b) {
+    const uint32_t lo = blocks.particle_begin[b], hi = blocks.particle_begin[std::min(b + 2, nb)];
+    for (uint32_t e = blocks.spring_begin[b]; e < blocks.spring_begin[b + 1]; ++e) {
+      if (s.i[e] < lo || s.i[e] >= blocks.particle_begin[b + 1] || s.j[e] >= hi)
+        return format("blocks: spring %u (%u, %u) lies outside block %u and the next", e, s.i[e],
+                      s.j[e], b);
+    }
+  }
+  for (uint32_t e = 0; e < ns; ++e)
+    if (!s.slots.alive(e) && s.stiffness[e] != 0.0f)
+      return format("spring %u is removed but pulls", e);
+
+  if (g.particle_count() != particle_count)
+    return format("graph: %u rows for %u particles", g.particle_count(), particle_count);
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> fresh(particle_count);
+  for (uint32_t e = 0; e < ns; ++e) {
+    if (!s.slots.alive(e)) continue;
+    if (s.i[e] >= particle_count || s.j[e] >= particle_count)
+      return format("spring %u (%u, %u) names a particle beyond %u", e, s.i[e], s.j[e],
+                    particle_count);
+    fresh[s.i[e]].emplace_back(s.j[e], e);
+    fresh[s.j[e]].emplace_back(s.i[e], e);
+  }
+  std::vector<std::pair<uint32_t, uint32_t>> row;
+  for (uint32_t p = 0; p < particle_count; ++p) {
+    if (g.row_size[p] > g.row_capacity[p] ||
+        size_t{g.row_begin[p]} + g.row_capacity[p] > g.neighbour.size())
+      return format("graph: row %u overruns its room", p);
+    row.clear();
+    for (uint32_t k = g.begin(p); k < g.end(p); ++k) {
+      if (k > g.begin(p) && g.neighbour[k] < g.neighbour[k - 1])
+        return format("graph: row %u is not sorted", p);
+      row.emplace_back(g.neighbour[k], g.spring[k]);
+    }
+    std::sort(row.begin(), row.end());
+    std::sort(fresh[p].begin(), fresh[p].end());
+    if (row != fresh[p])
+      return format("graph: row %u has %zu entries, a fresh build %zu (or other ones)", p,
+                    row.size(), fresh[p].size());
+  }
+  return "";
+}
+
 }  // namespace phaco::topology_check

@@ -25,7 +25,8 @@
 // tables; its edge-pair helpers are internal to that file, so the same sort-and-walk idea is used
 // here over half-edges that also carry their triangle.
 //
-// Reads: particles (slots, x, y, z, vx, vy, vz), triangles, springs. Writes: nothing.
+// Reads: particles (slots, x, y, z, vx, vy, vz), triangles, springs, spring blocks and graph.
+// Writes: nothing.
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -126,5 +127,17 @@ InvariantReport check_membrane(const Particles& particles, const Triangles& tria
 // Same, with a scratch of its own (allocates).
 InvariantReport check_membrane(const Particles& particles, const Triangles& triangles,
                                const Springs& springs, const InvariantThresholds& thresholds = {});
+
+// The force blocks and the spring graph against the spring table, as a cut's incremental refresh
+// leaves them (components/springs.hpp; O(S log S), for tests and debug runs):
+//  - blocks: spring ranges start at 0, never decrease and end at the tail, which runs to the end
+//    of the table, so a block pass visits every spring slot exactly once; every spring of planned
+//    block b has i in b's particles and j in b's or the next block's (two blocks of one parity
+//    never share a particle); a tombstone has stiffness 0 (the passes visit it);
+//  - graph: one row per particle; each row, as a set of (neighbour, spring), is what a fresh build
+//    from the live springs gives, and is sorted by neighbour.
+// Returns "" if consistent, else the first problem found.
+std::string check_spring_structure(const Springs& springs, const SpringBlocks& blocks,
+                                   const SpringGraph& graph, uint32_t particle_count);
 
 }  // namespace phaco::topology_check

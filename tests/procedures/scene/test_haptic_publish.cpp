@@ -64,7 +64,7 @@ TEST(HapticPublish, TheGraspedFlapComesWithItsWholeNeighbourhood) {
 
   const Entity capsule = *scene->body(BodyPart::Capsule);
   const Particles& p = scene->world.at<Particles>(capsule);
-  const CapsulePhysics& cp = scene->world.at<CapsulePhysics>(capsule);
+  const CapsuleSprings& cp = scene->world.at<CapsuleSprings>(capsule);
   const auto& g = scene->world.at<ToolGrasp>(scene->tools[0]);
   ASSERT_TRUE(g.capsule.holding());
 
@@ -90,7 +90,7 @@ TEST(HapticPublish, TheGraspedFlapComesWithItsWholeNeighbourhood) {
     ++free_nodes;
     const uint32_t i = particle_of[l];
     std::multiset<std::pair<float, float>> scene_springs, model_springs;
-    for (uint32_t k = cp.graph.offset[i]; k < cp.graph.offset[i + 1]; ++k) {
+    for (uint32_t k = cp.graph.begin(i); k < cp.graph.end(i); ++k) {
       const uint32_t sp = cp.graph.spring[k];
       scene_springs.insert({cp.springs.rest_length[sp], cp.springs.stiffness[sp]});
     }

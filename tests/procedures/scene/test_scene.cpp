@@ -196,7 +196,8 @@ TEST(CapsulePhysics, GraspLiftsTheCapsuleLocally) {
     const Particles before = scene->world.at<Particles>(capsule);
     for (uint64_t f = 0; f < scene->scenario.frame_count(); ++f) step(*scene);
     const Particles& p = scene->world.at<Particles>(capsule);
-    const CapsulePhysics& cp = scene->world.at<CapsulePhysics>(capsule);
+    const CapsuleStats& cp = scene->world.at<CapsuleStats>(capsule);
+    const CapsuleSolver& solver = scene->world.at<CapsuleSolver>(capsule);
     EXPECT_EQ(cp.grasps, 1u);
     const ToolGrasp& g = scene->world.at<ToolGrasp>(scene->tools[0]);
     ASSERT_TRUE(g.capsule.holding());
@@ -211,7 +212,7 @@ TEST(CapsulePhysics, GraspLiftsTheCapsuleLocally) {
     EXPECT_GT(lifted_neighbours, 3u) << "the membrane around the grasp rises with it";
     EXPECT_GT(cp.active_particle_max, 20u);
     EXPECT_LT(cp.active_particle_max, p.slots.size() / 2) << "cost stays local: the active set is a small part";
-    EXPECT_EQ(cp.state.status.fallbacks, 0u);
+    EXPECT_EQ(solver.state.status.fallbacks, 0u);
   }
 }
 

@@ -2,7 +2,9 @@
 // both layouts: random starts, lengths, angles and sampling speeds, paths forced through vertices
 // and along edges, curving tear-like paths, paths crossing earlier cuts and running off the rim.
 // After every path: zero invariant violations (systems/topology_check at its default thresholds)
-// and the cut bookkeeping consistent with a rebuild. Runs under ASan/UBSan in CI.
+// and the cut bookkeeping consistent with a rebuild; and the physics structure patched as the
+// scene patches it (spring graph rows patched, new springs in the blocks' tail, tombstones) equal
+// to a fresh build. Runs under ASan/UBSan in CI.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -46,8 +48,15 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
   const CounterRng rng(0xC0FFEE + 97 * level + static_cast<int>(layout), 4);
   FuzzTotals totals;
   test::CutSheet sheet;
+  SpringBlocks blocks;
+  SpringGraph graph;
   for (int p = 0; p < paths; ++p) {
-    if (p % kPathsPerMesh == 0) sheet = test::cut_sheet(mesh);
+    if (p % kPathsPerMesh == 0) {
+      sheet = test::cut_sheet(mesh);
+      blocks = springs::plan_blocks(sheet.springs, sheet.particles.slots.size());
+      graph = springs::build_spring_graph(sheet.springs, sheet.particles.slots.size());
+      sheet.topology.added_springs.clear(), sheet.topology.removed_springs.clear();
+    }
     CutMesh m = sheet.mesh();
     auto u = [&](uint32_t draw) { return rng.uniform_double(static_cast<uint64_t>(p), draw, 0); };
     const int style = static_cast<int>(u(0) * 5);  // 0 straight, 1 through vertices, 2 along edges, 3 curving, 4 off the rim
@@ -109,6 +118,13 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
     ++totals.paths;
     const ::testing::AssertionResult ok = test::sound(sheet);
     ASSERT_TRUE(ok) << "path " << p << " (style " << style << ", " << samples.size() << " samples)";
+    springs::patch_spring_graph(graph, sheet.springs, sheet.particles.slots.size(),
+                                sheet.topology.removed_springs, sheet.topology.added_springs);
+    sheet.topology.added_springs.clear(), sheet.topology.removed_springs.clear();
+    ASSERT_EQ(topology_check::check_spring_structure(sheet.springs, blocks, graph,
+                                                     sheet.particles.slots.size()),
+              "")
+        << "path " << p;
   }
   EXPECT_EQ(totals.paths, static_cast<uint64_t>(paths));
   EXPECT_GT(totals.segments, static_cast<uint64_t>(paths));

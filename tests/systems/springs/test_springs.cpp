@@ -2,11 +2,13 @@
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
-#include "tests/support/membrane_tables.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/springs/springs.hpp"
+#include "tests/support/membrane_tables.hpp"
 
 namespace phaco {
 namespace {
@@ -225,6 +227,65 @@ TEST(SpringForces, BitIdenticalForOneTwoAndFourThreads) {
   const auto one = forces_with_threads(1, s, sp, b);
   EXPECT_EQ(one, forces_with_threads(2, s, sp, b));
   EXPECT_EQ(one, forces_with_threads(4, s, sp, b));
+}
+
+// Springs appended after the plan (a cut's tail) and tombstones of stiffness 0: the tail runs
+// serially after the blocks, so the forces stay bit-identical for any thread count, and they equal
+// a fresh plan of the same springs up to float rounding.
+TEST(SpringForces, TailAfterThePlanIsBitIdenticalForOneTwoAndFourThreads) {
+  Sheet s = capsule(3);
+  const uint32_t n = s.particles.slots.size();
+  for (uint32_t i = 0; i < n; ++i) s.particles.z[i] += 0.003f * std::sin(0.1f * i);
+  Springs sp = springs::build_springs(s.particles, s.triangles, {.prestretch = 0.02});
+  const SpringBlocks b = springs::plan_blocks(sp, n, 64);
+  for (uint32_t e = 0; e < sp.slots.size();
+       e += 7) {  // tombstones, and their pairs again in the tail
+    const uint32_t t = table_append(sp, 1);
+    sp.i[t] = sp.i[e], sp.j[t] = sp.j[e], sp.rest_length[t] = sp.rest_length[e],
+    sp.stiffness[t] = sp.stiffness[e];
+    table_remove(sp, e);
+    sp.stiffness[e] = 0.0f;
+  }
+  ASSERT_GT(sp.slots.size(), b.tail_begin());
+  const auto one = forces_with_threads(1, s, sp, b);
+  EXPECT_EQ(one, forces_with_threads(2, s, sp, b));
+  EXPECT_EQ(one, forces_with_threads(4, s, sp, b));
+  const Springs fresh = springs::build_springs(s.particles, s.triangles, {.prestretch = 0.02});
+  const auto planned = forces_with_threads(1, s, fresh, springs::plan_blocks(fresh, n, 64));
+  ASSERT_EQ(one.size(), planned.size());
+  for (size_t k = 0; k < one.size(); ++k)
+    ASSERT_NEAR(one[k], planned[k], 1e-4f * (1.0f + std::fabs(planned[k])));
+}
+
+// Rows patched by added and removed springs, past their room (a row moves), equal a fresh build's
+// rows entry for entry (sorted by neighbour); new particles get rows.
+TEST(SpringGraph, PatchedRowsEqualAFreshBuild) {
+  Sheet s = capsule(0);
+  uint32_t n = s.particles.slots.size();
+  Springs sp = springs::build_springs(s.particles, s.triangles, {});
+  SpringGraph g = springs::build_spring_graph(sp, n);
+  std::vector<uint32_t> added, removed;
+  for (uint32_t e = 0; e < sp.slots.size(); e += 5) table_remove(sp, e), removed.push_back(e);
+  // Six new particles, each joined to particle 0 (whose row overflows its room) and to the
+  // previous new one.
+  const uint32_t first = n;
+  n += 6;
+  for (uint32_t a = first; a < n; ++a)
+    for (uint32_t b : {0u, a - 1}) {
+      if (b == a - 1 && a == first) continue;
+      const uint32_t t = table_append(sp, 1);
+      sp.i[t] = std::min(a, b), sp.j[t] = std::max(a, b);
+      added.push_back(t);
+    }
+  const uint32_t gone = table_append(sp, 1);  // added, then removed before the patch
+  sp.i[gone] = 1, sp.j[gone] = 2;
+  added.push_back(gone), table_remove(sp, gone), removed.push_back(gone);
+  springs::patch_spring_graph(g, sp, n, removed, added);
+  const SpringGraph fresh = springs::build_spring_graph(sp, n);
+  ASSERT_EQ(g.particle_count(), n);
+  for (uint32_t v = 0; v < n; ++v)
+    ASSERT_EQ(springs::graph_row(g, v), springs::graph_row(fresh, v)) << v;
+  EXPECT_GT(g.row_capacity[0], fresh.row_size[0]) << "particle 0's row moved to a larger room";
 }
 
 TEST(Springs, StiffnessOverMassBoundsTheExplicitStep) {
