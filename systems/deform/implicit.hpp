@@ -97,6 +97,9 @@ struct ImplicitSettings {
   // small active set pays no threading overhead. Measured (docs/implicit_and_active.md).
   uint32_t parallel_min_unknowns = 4096;
   uint32_t parallel_grain_unknowns = 1024;
+  // TwoLevel: rebuild the hierarchy when more than this fraction of the unknowns entered or left
+  // the set since its build (otherwise reuse it stale); a topology change always rebuilds.
+  double two_level_rebuild_fraction = 0.2;
   // Backtracking on the incremental potential: halve the Newton step at most this many times.
   int max_line_search_halvings = 12;
   PredictorStiffness predictor_stiffness = PredictorStiffness::FrozenJacobian;
@@ -198,7 +201,8 @@ struct ImplicitCache {
   ImplicitStats stats;
 
   // Call after a cut or tear (topology), or a material change: rebuilds pattern and factorisation.
-  void invalidate() { pattern.valid = false, predictor_valid = false; }
+  void invalidate() { pattern.valid = false, predictor_valid = false, ++topology_changes; }
+  uint64_t topology_changes = 0;  // invalidate() calls
 
   // --- implicit Euler ---
   UnknownSet unknowns;

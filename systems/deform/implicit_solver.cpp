@@ -134,65 +134,124 @@ double estimate_spectral_radius(const ImplicitCache& cache, std::span<const Sym3
   return rho;
 }
 
+// Step 4 for TwoLevel: aggregates, smoothed prolongator and Galerkin coarse operator of today's A.
 void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
+  using Block3 = PreconditionerState::Block3;
   const BlockPattern& pattern = cache.pattern;
+  const std::span<const Sym3> blocks(cache.system.block);
   const uint32_t n = pattern.rows();
   std::vector<uint32_t> aggregate_of;
   const uint32_t na = aggregate(pattern, aggregate_of);
   state.aggregates = na;
-  const double rho = estimate_spectral_radius(cache, state.inverse_block);
-  const double omega = 4.0 / (3.0 * rho);
+  const double omega = 4.0 / (3.0 * estimate_spectral_radius(cache, state.inverse_block));
   state.smoother_weight = omega;
 
-  // Smoothed prolongator P = (I − ω·D⁻¹·A)·P₀, P₀ = 1 in (3u + a, 3·aggregate(u) + a). Row u of
-  // P touches the aggregates of u's neighbours: P_u,J = δ(agg(u), J)·I − ω·D_u⁻¹·Σ_{w∈J} A_uw.
-  using Triplet = Eigen::Triplet<double>;
-  std::vector<Triplet> entries;
-  entries.reserve(size_t(9) * pattern.col.size());
-  std::vector<std::array<double, 9>> sum;  // per aggregate touched by the row: Σ A_uw
-  std::vector<uint32_t> touched;
+  // Smoothed prolongator P = (I − ω·D⁻¹·A)·P₀, P₀ = I in block (u, aggregate(u)): the constant
+  // near-null space per axis. Row u of P touches the aggregates of u's neighbours:
+  // P_uJ = δ(aggregate(u), J)·I − ω·D_u⁻¹·Σ_{w∈J} A_uw.
   std::vector<uint32_t> slot(na, kNotUnknown);
+  std::vector<Block3> sum;  // per aggregate the row touches: Σ_{w∈J} A_uw
+  state.p_begin.assign(n + 1, 0);
+  state.p_aggregate.clear();
+  state.p_block.clear();
   for (uint32_t u = 0; u < n; ++u) {
-    touched.clear();
-    sum.clear();
+    const size_t first = state.p_aggregate.size();
     for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
       const uint32_t agg = aggregate_of[pattern.col[b]];
       if (slot[agg] == kNotUnknown) {
-        slot[agg] = static_cast<uint32_t>(touched.size());
-        touched.push_back(agg);
+        slot[agg] = static_cast<uint32_t>(state.p_aggregate.size() - first);
+        state.p_aggregate.push_back(agg);
         sum.push_back({});
       }
-      std::array<double, 9>& s = sum[slot[agg]];
+      Block3& s = sum[slot[agg]];
       for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) s[3 * a + c] += sym_at(cache.system.block[b], a, c);
+        for (int c = 0; c < 3; ++c) s[3 * a + c] += sym_at(blocks[b], a, c);
     }
     const Sym3& dinv = state.inverse_block[u];
-    for (size_t t = 0; t < touched.size(); ++t) {
-      const uint32_t agg = touched[t];
-      const std::array<double, 9>& s = sum[t];
+    for (size_t t = first; t < state.p_aggregate.size(); ++t) {
+      const uint32_t agg = state.p_aggregate[t];
+      const Block3& s = sum[t - first];
+      Block3 pb;
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) {
           double v = 0.0;
           for (int q = 0; q < 3; ++q) v += sym_at(dinv, a, q) * s[3 * q + c];
-          v = (agg == aggregate_of[u] && a == c ? 1.0 : 0.0) - omega * v;
-          if (v != 0.0) entries.emplace_back(int(3 * u) + a, int(3 * agg) + c, v);
+          pb[3 * a + c] = (agg == aggregate_of[u] && a == c ? 1.0 : 0.0) - omega * v;
         }
+      state.p_block.push_back(pb);
       slot[agg] = kNotUnknown;
     }
+    sum.clear();
+    state.p_begin[u + 1] = static_cast<uint32_t>(state.p_aggregate.size());
   }
-  state.prolongation.resize(3 * Eigen::Index(n), 3 * Eigen::Index(na));
-  state.prolongation.setFromTriplets(entries.begin(), entries.end());
-  state.restriction = state.prolongation.transpose();
 
-  // Galerkin coarse operator Pᵀ·A·P, factorised once per build.
-  const Eigen::SparseMatrix<double> a =
-      cache.system.matrix;  // symmetric: its column-major copy is itself
-  const Eigen::SparseMatrix<double> ap = a * state.prolongation;
-  const Eigen::SparseMatrix<double> coarse = state.restriction * ap;
+  // Galerkin coarse operator A_c = Pᵀ·A·P, lower triangle (all SimplicialLLT reads): row u of A·P
+  // gathered per aggregate, then A_c(I, J) += P_uIᵀ·(A·P)_uJ.
+  using Triplet = Eigen::Triplet<double>;
+  std::vector<Triplet> entries;
+  std::vector<uint32_t> touched;
+  for (uint32_t u = 0; u < n; ++u) {
+    touched.clear();
+    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
+      const uint32_t w = pattern.col[b];
+      for (uint32_t pb = state.p_begin[w]; pb < state.p_begin[w + 1]; ++pb) {
+        const uint32_t agg = state.p_aggregate[pb];
+        if (slot[agg] == kNotUnknown) {
+          slot[agg] = static_cast<uint32_t>(touched.size());
+          touched.push_back(agg);
+          sum.push_back({});
+        }
+        Block3& s = sum[slot[agg]];
+        const Block3& p = state.p_block[pb];
+        for (int a = 0; a < 3; ++a)
+          for (int c = 0; c < 3; ++c)
+            s[3 * a + c] += sym_at(blocks[b], a, 0) * p[c] + sym_at(blocks[b], a, 1) * p[3 + c] +
+                            sym_at(blocks[b], a, 2) * p[6 + c];
+      }
+    }
+    for (uint32_t pb = state.p_begin[u]; pb < state.p_begin[u + 1]; ++pb) {
+      const uint32_t row_agg = state.p_aggregate[pb];
+      const Block3& p = state.p_block[pb];
+      for (size_t t = 0; t < touched.size(); ++t) {
+        const uint32_t col_agg = touched[t];
+        if (col_agg > row_agg) continue;
+        const Block3& ap = sum[t];
+        for (int a = 0; a < 3; ++a)
+          for (int c = 0; c < 3; ++c) {
+            if (row_agg == col_agg && c > a) continue;
+            const double v = p[a] * ap[c] + p[3 + a] * ap[3 + c] + p[6 + a] * ap[6 + c];
+            entries.emplace_back(int(3 * row_agg) + a, int(3 * col_agg) + c, v);
+          }
+      }
+    }
+    for (uint32_t agg : touched) slot[agg] = kNotUnknown;
+    sum.clear();
+  }
+  Eigen::SparseMatrix<double> coarse(3 * Eigen::Index(na), 3 * Eigen::Index(na));
+  coarse.setFromTriplets(entries.begin(), entries.end());
   state.coarse.compute(coarse);
-  state.residual.resize(3 * Eigen::Index(n));
+  state.built_particles = cache.unknowns.particles;
+  state.built_for_topology = cache.topology_changes;
   state.coarse_rhs.resize(3 * Eigen::Index(na));
   state.coarse_solution.resize(3 * Eigen::Index(na));
+}
+
+// Maps today's unknowns to the rows of the prolongator built earlier (both particle lists are
+// sorted); returns how many unknowns entered or left the set since the build.
+size_t map_two_level_rows(const ImplicitCache& cache, PreconditionerState& state) {
+  const std::vector<uint32_t>& now = cache.unknowns.particles;
+  const std::vector<uint32_t>& built = state.built_particles;
+  state.p_row_of_unknown.assign(now.size(), kNotUnknown);
+  size_t matched = 0;
+  for (size_t u = 0, r = 0; u < now.size() && r < built.size();) {
+    if (now[u] < built[r])
+      ++u;
+    else if (built[r] < now[u])
+      ++r;
+    else
+      state.p_row_of_unknown[u++] = static_cast<uint32_t>(r++), ++matched;
+  }
+  return (now.size() - matched) + (built.size() - matched);
 }
 
 }  // namespace
@@ -266,24 +325,29 @@ void update_preconditioner(ImplicitCache& cache) {
       state.inverse_block[u] = inverse_sym(blocks[pattern.diag_pos[u] + pattern.row_begin[u]]);
   }
 
-  const bool factored =
-      kind == Preconditioner::IncompleteCholesky || kind == Preconditioner::TwoLevel;
-  const bool stale_ok = state.kind == kind && state.built_for_pattern == cache.stats.pattern_builds;
+  const bool kind_changed = state.kind != kind;
   state.kind = kind;
-  if (!factored || stale_ok) return;
-  // The pattern (unknown set or topology) changed: factorise today's A and reuse it until the next
-  // change.
-  if (cache.settings.cg_operator != CgOperator::Assembled)
-    write_matrix_pattern(pattern, cache.system.matrix);
-  write_matrix_values(pattern, blocks, cache.system.matrix);
   if (kind == Preconditioner::IncompleteCholesky) {
-    const Eigen::SparseMatrix<double> a = cache.system.matrix;
+    // Rebuilt with the pattern (unknown set or topology), otherwise reused stale.
+    if (!kind_changed && state.built_for_pattern == cache.stats.pattern_builds) return;
+    if (cache.settings.cg_operator != CgOperator::Assembled)
+      write_matrix_pattern(pattern, cache.system.matrix);
+    write_matrix_values(pattern, blocks, cache.system.matrix);
+    const Eigen::SparseMatrix<double> a = cache.system.matrix;  // symmetric: column-major = itself
     state.incomplete_cholesky.compute(a);
-  } else {
+    state.built_for_pattern = cache.stats.pattern_builds;
+    ++cache.stats.preconditioner_builds;
+  } else if (kind == Preconditioner::TwoLevel) {
+    // Rebuilt after a topology change or when the set moved on by more than the fraction.
+    state.residual.resize(3 * Eigen::Index(nu));
+    const bool same_topology = !kind_changed && state.built_for_topology == cache.topology_changes;
+    const size_t moved = same_topology ? map_two_level_rows(cache, state) : ~size_t(0);
+    if (same_topology && double(moved) <= cache.settings.two_level_rebuild_fraction * double(nu))
+      return;
     build_two_level(cache, state);
+    map_two_level_rows(cache, state);
+    ++cache.stats.preconditioner_builds;
   }
-  state.built_for_pattern = cache.stats.pattern_builds;
-  ++cache.stats.preconditioner_builds;
 }
 
 namespace {
@@ -334,9 +398,32 @@ void apply_preconditioner(const ImplicitCache& cache, const double* r, double* z
       apply_block_inverse(state.inverse_block, r, z, w, false, settings);
       Eigen::Map<Eigen::VectorXd>(t.data(), size) = Eigen::Map<const Eigen::VectorXd>(r, size);
       add_block_product(cache.pattern, blocks, z, t.data(), -1.0, settings);
-      state.coarse_rhs.noalias() = state.restriction * t;
+      // Restriction Pᵀ·t and, after the coarse solve, prolongation, over the rows of P that
+      // today's unknowns still have.
+      state.coarse_rhs.setZero();
+      const uint32_t nu = cache.pattern.rows();
+      for (uint32_t u = 0; u < nu; ++u) {
+        const uint32_t row = state.p_row_of_unknown[u];
+        if (row == kNotUnknown) continue;
+        const double* tu = t.data() + 3 * size_t(u);
+        for (uint32_t pb = state.p_begin[row]; pb < state.p_begin[row + 1]; ++pb) {
+          const PreconditionerState::Block3& p = state.p_block[pb];
+          double* c = state.coarse_rhs.data() + 3 * size_t(state.p_aggregate[pb]);
+          for (int a = 0; a < 3; ++a) c[a] += p[a] * tu[0] + p[3 + a] * tu[1] + p[6 + a] * tu[2];
+        }
+      }
       state.coarse_solution = state.coarse.solve(state.coarse_rhs);
-      Eigen::Map<Eigen::VectorXd>(z, size).noalias() += state.prolongation * state.coarse_solution;
+      for (uint32_t u = 0; u < nu; ++u) {
+        const uint32_t row = state.p_row_of_unknown[u];
+        if (row == kNotUnknown) continue;
+        double* zu = z + 3 * size_t(u);
+        for (uint32_t pb = state.p_begin[row]; pb < state.p_begin[row + 1]; ++pb) {
+          const PreconditionerState::Block3& p = state.p_block[pb];
+          const double* e = state.coarse_solution.data() + 3 * size_t(state.p_aggregate[pb]);
+          for (int a = 0; a < 3; ++a)
+            zu[a] += p[3 * a] * e[0] + p[3 * a + 1] * e[1] + p[3 * a + 2] * e[2];
+        }
+      }
       Eigen::Map<Eigen::VectorXd>(t.data(), size) = Eigen::Map<const Eigen::VectorXd>(r, size);
       add_block_product(cache.pattern, blocks, z, t.data(), -1.0, settings);
       apply_block_inverse(state.inverse_block, t.data(), z, w, true, settings);
