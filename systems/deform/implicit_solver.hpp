@@ -15,7 +15,9 @@
 //   Jacobi              1/diag(A).
 //   BlockJacobi         the inverse of each node's 3×3 diagonal block: catches each node's
 //                       in-plane / out-of-plane anisotropy, exactly, at the cost of Jacobi.
-//   IncompleteCholesky  Eigen::IncompleteCholesky (zero fill, AMD ordering) of the assembled A.
+//   IncompleteCholesky  Eigen::IncompleteCholesky (zero fill) of the assembled A in the unknowns'
+//                       own order (sorted particles: mesh-local). Natural order converges faster
+//                       than AMD here (level 3 expert: 40.9 against 54.5 iterations per frame).
 //   TwoLevel            smoothed aggregation (Tamstorf, Jones & McCormick 2015, "Smoothed
 //                       aggregation multigrid for cloth simulation"), one level below the active
 //                       set: aggregates of neighbouring nodes (Vaněk's greedy phases over the block
@@ -58,7 +60,7 @@ struct PreconditionerState {
   uint64_t built_for_pattern = ~uint64_t(0);  // stats.pattern_builds when factorised
   Eigen::VectorXd inverse_diagonal;           // Jacobi: 3 per unknown
   std::vector<Sym3> inverse_block;            // BlockJacobi and the two-level smoother: per unknown
-  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> incomplete_cholesky;
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> incomplete_cholesky;
   // Two-level: the smoothed prolongator P as 3×3 blocks, row by row over the unknowns it was built
   // on (keyed by particle, so it outlives small changes of the set), the coarse factor, and the
   // damping ω = 4/(3ρ) of the block-Jacobi smoother, ρ ≈ spectral radius of D⁻¹A at the build.
