@@ -29,15 +29,17 @@
 // (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each particle, preconditioned by
 // settings.preconditioner (implicit_solver.hpp): Jacobi, 3×3 block-Jacobi, incomplete Cholesky
 // of the assembled matrix, or a two-level smoothed-aggregation cycle (Tamstorf, Jones & McCormick
-// 2015). The factored ones are rebuilt only when the unknown set or the topology changes and are
-// otherwise reused stale (still SPD, so CG stays valid; only its speed depends on staleness).
+// 2015). Incomplete Cholesky is refactored when the unknown set or the topology changes, the
+// two-level hierarchy after a topology change or a large change of the set; otherwise both are
+// reused stale (still SPD, so CG stays valid; only its speed depends on staleness).
 // Two operators: an assembled row-major sparse matrix whose pattern is built once per unknown set
 // and whose values are refilled every step, or a matrix-free product over the stored 3×3 blocks of
-// the block-CSR rows (the default: it streams ~3× fewer bytes per product and measured 2.2–3.4×
-// faster per step at levels 0–5, docs/implicit_and_active.md). The matrix-free product gathers
-// each row in a fixed order, so it runs on several threads above settings.parallel_min_unknowns
-// and gives the same bits on any thread count. Eigen's CG allocates its four work vectors once
-// per solve; nothing else in a steady-state step allocates.
+// the block-CSR rows (the default: ~2× fewer bytes per product; in its earlier scatter-over-springs
+// form it measured 2.2–3.4× faster per step at levels 0–5, docs/implicit_and_active.md). The
+// matrix-free product gathers each row in a fixed order, so it runs on several threads above
+// settings.parallel_min_unknowns and gives the same bits on any thread count. Eigen's CG allocates
+// its four work vectors once per solve, and the factored preconditioners when they are rebuilt;
+// nothing else in a steady-state step allocates.
 //
 // Approximate implicit predictor (seed 004 "pre computes the solution to a linear system [9]",
 // [9] = Desbrun, Schröder & Barr 1999): the system matrix is frozen and factorised once

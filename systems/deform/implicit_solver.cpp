@@ -319,7 +319,7 @@ void update_preconditioner(ImplicitCache& cache) {
       state.inverse_diagonal[3 * u] = 1.0 / d[0], state.inverse_diagonal[3 * u + 1] = 1.0 / d[3];
       state.inverse_diagonal[3 * u + 2] = 1.0 / d[5];
     }
-  } else {
+  } else if (kind != Preconditioner::IncompleteCholesky) {  // block-Jacobi, two-level smoother
     state.inverse_block.resize(nu);
     for (uint32_t u = 0; u < nu; ++u)
       state.inverse_block[u] = inverse_sym(blocks[pattern.diag_pos[u] + pattern.row_begin[u]]);
