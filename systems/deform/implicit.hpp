@@ -25,13 +25,21 @@
 // Δx = dt·(v_n + Δv) above; the step x⁺ = x_n + α·Δx, v⁺ = α·Δx/dt takes the largest α in
 // {1, ½, ¼, ...} with Φ(x⁺) ≤ Φ(x_n). With α = 1 (the usual case) it is Baraff–Witkin's step.
 //
-// The system is solved with Eigen::ConjugateGradient (Jacobi preconditioner), relative tolerance
-// settings.cg_tolerance (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each
-// particle. Two operators: an assembled row-major sparse matrix whose pattern is built once per
-// unknown set and whose values are refilled every step, or a matrix-free operator over the stored
-// spring and diagonal blocks (the default: it streams ~3× fewer bytes per product and measured
-// 2.2–3.4× faster per step at levels 0–5, docs/implicit_and_active.md). Eigen's CG allocates its
-// four work vectors once per solve; nothing else in a steady-state step allocates.
+// The system is solved with Eigen::ConjugateGradient, relative tolerance settings.cg_tolerance
+// (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each particle, preconditioned by
+// settings.preconditioner (implicit_solver.hpp): Jacobi, 3×3 block-Jacobi, incomplete Cholesky
+// of the assembled matrix, or a two-level smoothed-aggregation cycle (Tamstorf, Jones & McCormick
+// 2015). Incomplete Cholesky is refactored when the unknown set or the topology changes, the
+// two-level hierarchy after a topology change or a large change of the set; otherwise both are
+// reused stale (still SPD, so CG stays valid; only its speed depends on staleness).
+// Two operators: an assembled row-major sparse matrix whose pattern is built once per unknown set
+// and whose values are refilled every step, or a matrix-free product over the stored 3×3 blocks of
+// the block-CSR rows (the default: ~2× fewer bytes per product; in its earlier scatter-over-springs
+// form it measured 2.2–3.4× faster per step at levels 0–5, docs/implicit_and_active.md). The
+// matrix-free product gathers each row in a fixed order, so it runs on several threads above
+// settings.parallel_min_unknowns and gives the same bits on any thread count. Eigen's CG allocates
+// its four work vectors once per solve, and the factored preconditioners when they are rebuilt;
+// nothing else in a steady-state step allocates.
 //
 // Approximate implicit predictor (seed 004 "pre computes the solution to a linear system [9]",
 // [9] = Desbrun, Schröder & Barr 1999): the system matrix is frozen and factorised once
@@ -63,9 +71,11 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <array>
-#include <span>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "systems/deform/membrane.hpp"
@@ -74,12 +84,24 @@ namespace phaco::deform {
 
 enum class CgOperator : uint8_t { Assembled, MatrixFree };
 enum class PredictorStiffness : uint8_t { Isotropic, FrozenJacobian };
+// CG preconditioners of implicit Euler (implicit_solver.hpp, docs/implicit_and_active.md).
+enum class Preconditioner : uint8_t { Jacobi, BlockJacobi, IncompleteCholesky, TwoLevel };
 
 struct ImplicitSettings {
   double cg_tolerance = 1.0e-6;  // relative residual
   int cg_max_iterations = 1000;
   bool warm_start = true;
-  CgOperator cg_operator = CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
+  CgOperator cg_operator =
+      CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
+  Preconditioner preconditioner = Preconditioner::BlockJacobi;
+  // The matrix-free product and the block preconditioners split their rows over threads from this
+  // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a
+  // small active set pays no threading overhead. Measured (docs/implicit_and_active.md).
+  uint32_t parallel_min_unknowns = 4096;
+  uint32_t parallel_grain_unknowns = 1024;
+  // TwoLevel: rebuild the hierarchy when more than this fraction of the unknowns entered or left
+  // the set since its build (otherwise reuse it stale); a topology change always rebuilds.
+  double two_level_rebuild_fraction = 0.2;
   // Backtracking on the incremental potential: halve the Newton step at most this many times.
   int max_line_search_halvings = 12;
   PredictorStiffness predictor_stiffness = PredictorStiffness::FrozenJacobian;
@@ -88,20 +110,24 @@ struct ImplicitSettings {
   double predictor_quadratic_extension_mm = 0.01;
 };
 
+std::string_view to_string(Preconditioner p);
+std::optional<Preconditioner> parse_preconditioner(std::string_view s);
+
 struct ImplicitStats {
-  uint64_t steps = 0;              // implicit Euler steps
-  int cg_iterations = 0;           // last step
-  double cg_residual = 0.0;        // last step, ‖r‖/‖b‖
-  bool cg_converged = true;        // last step reached the tolerance
-  double step_fraction = 1.0;      // last step: line-search fraction α of the Newton step taken
-  uint64_t line_search_cuts = 0;   // steps that took α < 1
+  uint64_t steps = 0;             // implicit Euler steps
+  int cg_iterations = 0;          // last step
+  double cg_residual = 0.0;       // last step, ‖r‖/‖b‖
+  bool cg_converged = true;       // last step reached the tolerance
+  double step_fraction = 1.0;     // last step: line-search fraction α of the Newton step taken
+  uint64_t line_search_cuts = 0;  // steps that took α < 1
   uint64_t cg_iterations_total = 0;
-  uint32_t unknowns = 0;           // particles solved for, last step
-  uint32_t springs = 0;            // springs assembled, last step
-  uint64_t nonzeros = 0;           // scalar entries of the operator (stored or applied), last step
-  uint64_t pattern_builds = 0;     // implicit Euler: unknown set or springs changed
+  uint32_t unknowns = 0;        // particles solved for, last step
+  uint32_t springs = 0;         // springs assembled, last step
+  uint64_t nonzeros = 0;        // scalar entries of the operator (stored or applied), last step
+  uint64_t pattern_builds = 0;  // implicit Euler: unknown set or springs changed
+  uint64_t preconditioner_builds = 0;  // incomplete Cholesky / two-level factorisations
   uint64_t predictor_steps = 0;
-  uint64_t precomputations = 0;    // predictor factorisations
+  uint64_t precomputations = 0;  // predictor factorisations
   uint32_t predictor_unknowns = 0;
 };
 
@@ -117,8 +143,58 @@ struct SpringForceJacobian {
 // quadratic F = k·(l − l0)·|l − l0|; block = F'(l)·d̂d̂ᵀ + max(F/l, 0)·(I − d̂d̂ᵀ). The transverse
 // term F/l is negative under compression; it is clamped to zero so the block, and with it the
 // system matrix, stays positive semidefinite (the buckling direction gets no negative stiffness).
-SpringForceJacobian spring_force_jacobian(double dx, double dy, double dz, double rest_length, double stiffness,
-                                          SpringLaw law);
+SpringForceJacobian spring_force_jacobian(double dx, double dy, double dz, double rest_length,
+                                          double stiffness, SpringLaw law);
+
+constexpr uint32_t kNotUnknown = 0xffffffffu;
+
+// --- implicit Euler's cache, by part ---
+
+// Which particles the step solves for. Per-particle arrays grow with the particle table (a cut
+// appends particles) and keep their contents.
+struct UnknownSet {
+  std::vector<uint32_t> unknown_of;  // per particle: unknown index, or kNotUnknown
+  std::vector<uint32_t> particles;   // particle of each unknown, sorted
+  std::vector<uint32_t> springs;     // springs with an unknown end, sorted
+  std::vector<uint32_t> candidate_particles, candidate_springs;  // scratch of the next selection
+};
+
+// Block-CSR sparsity of the system over the unknowns (row u: u itself and the unknowns joined to
+// it by a step spring, sorted). Built once per unknown set; indices into UnknownSet::springs.
+struct BlockPattern {
+  bool valid = false;
+  CgOperator built_for =
+      CgOperator::MatrixFree;       // the assembled operator also needs `matrix`'s pattern
+  std::vector<uint32_t> row_begin;  // per unknown + 1: first block of the row
+  std::vector<uint32_t> col;        // per block: column unknown
+  std::vector<uint32_t> diag_pos;   // per unknown: block of the diagonal
+  std::vector<uint32_t> spring_ui,
+      spring_uj;  // per step spring: unknown of each end, or kNotUnknown
+  std::vector<uint32_t> spring_pos_ij,
+      spring_pos_ji;  // per step spring: block of j in i's row and back
+  uint32_t rows() const {
+    return row_begin.empty() ? 0u : static_cast<uint32_t>(row_begin.size() - 1);
+  }
+};
+
+// This step's system A·Δv = b (A = M(1 + dt(γ+κ)) + dt²(K + g·I), b = dt·(f + dt·K·v), see top).
+struct StepSystem {
+  std::vector<Sym3> spring_k;  // per step spring: ∂f_i/∂x_j, mN/mm
+  std::vector<Sym3> block;     // per block of the pattern: A's 3×3 block, kg (mN·s²/mm)
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int>
+      matrix;                 // assembled A (Assembled operator, factorisations)
+  Eigen::VectorXd force;      // 3 per unknown: f at the start of the step, mN
+  Eigen::VectorXd rhs;        // 3 per unknown: b, mN·s
+  Eigen::VectorXd guess, dv;  // 3 per unknown: CG's first guess and answer Δv, mm/s
+  Eigen::VectorXd step_dx;    // 3 per unknown: Newton step Δx = dt·(v + Δv), mm
+};
+
+// Factorised preconditioner state (implicit_solver.hpp); opaque here to keep Eigen's sparse
+// factorisations out of every includer.
+struct PreconditionerState;
+struct PreconditionerStateDeleter {
+  void operator()(PreconditionerState* p) const;
+};
 
 // Scratch and state carried between steps of one body. Sized on first use (and when the particle
 // count or the unknown set changes); steady-state steps reuse it.
@@ -127,50 +203,42 @@ struct ImplicitCache {
   ImplicitStats stats;
 
   // Call after a cut or tear (topology), or a material change: rebuilds pattern and factorisation.
-  void invalidate() { pattern_valid = false, predictor_valid = false; }
+  void invalidate() { pattern.valid = false, predictor_valid = false, ++topology_changes; }
+  uint64_t topology_changes = 0;  // invalidate() calls
 
   // --- implicit Euler ---
-  bool pattern_valid = false;
-  CgOperator pattern_operator = CgOperator::MatrixFree;  // the operator the pattern was built for
-  std::vector<double> warm_dv;             // 3 per particle: the last Δv, the CG's first guess
-  std::vector<uint32_t> unknown_of;        // per particle: unknown index, or kNotUnknown
-  std::vector<uint32_t> unknowns;          // particle of each unknown, sorted
-  std::vector<uint32_t> step_springs;      // springs with an unknown end, sorted
-  std::vector<uint32_t> candidate_unknowns, candidate_springs;
-  std::vector<uint32_t> spring_ui, spring_uj;      // unknown index of each end, or kNotUnknown
-  std::vector<uint32_t> spring_pos_ij, spring_pos_ji;  // block position of j in i's row and back
-  std::vector<uint32_t> block_begin, block_col;    // block CSR over unknowns (self included)
-  std::vector<uint32_t> diag_pos;                  // block position of the diagonal in each row
-  std::vector<Sym3> spring_k;                      // per step spring: Jacobian block
-  std::vector<Sym3> diag_block;                    // per unknown: diagonal block of the system
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> matrix;
-  Eigen::VectorXd force, rhs, dv, guess, inverse_diagonal, step_dx;
+  UnknownSet unknowns;
+  BlockPattern pattern;
+  StepSystem system;
+  std::vector<double> warm_dv;  // 3 per particle: the last Δv (mm/s), CG's first guess
+  std::unique_ptr<PreconditionerState, PreconditionerStateDeleter> preconditioner;
 
   // --- predictor ---
   bool predictor_valid = false;
-  uint64_t predictor_key = 0;                 // hash of what the factorisation depends on
+  uint64_t predictor_key = 0;                  // hash of what the factorisation depends on
   std::vector<uint32_t> predictor_unknown_of;  // per particle
   std::vector<uint32_t> predictor_unknowns;
-  std::vector<uint32_t> predictor_springs;     // springs with an unknown end
-  std::vector<Sym3> predictor_k;               // per predictor spring: frozen block (k·I when isotropic)
+  std::vector<uint32_t> predictor_springs;  // springs with an unknown end
+  std::vector<Sym3> predictor_k;  // per predictor spring: frozen block (k·I when isotropic)
   // Behind a pointer so the cache (and every body's state holding it) stays movable: Eigen's
   // factorisations are neither copyable nor movable.
   std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> predictor_factor =
       std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
-  Eigen::VectorXd predictor_force, predictor_rhs, predictor_dv;  // 3 per unknown
+  Eigen::VectorXd predictor_force, predictor_rhs, predictor_dv, predictor_dx;  // 3 per unknown
 };
-
-constexpr uint32_t kNotUnknown = 0xffffffffu;
 
 namespace implicit_detail {
 // Mass scaling as the other deform integrators read it: a non-positive scale counts as 1.
-inline double mass_scale(const Dynamics& d) { return d.mass_scale > 0.0f ? double(d.mass_scale) : 1.0; }
+inline double mass_scale(const Dynamics& d) {
+  return d.mass_scale > 0.0f ? double(d.mass_scale) : 1.0;
+}
 
 // The largest α in {1, ½, ¼, ...} (at most settings.max_line_search_halvings cuts) with
 // Φ(x_n + α·Δx) ≤ Φ(x_n), Φ the incremental potential above. unknown_of maps a particle to its
 // unknown u (Δx at step_dx[3u..3u+2]) or kNotUnknown; `springs` are those with an unknown end.
-double line_search(const Membrane& m, double dt, int max_halvings, std::span<const uint32_t> unknowns,
-                   std::span<const uint32_t> unknown_of, std::span<const uint32_t> springs, const double* step_dx);
+double line_search(const Membrane& m, double dt, int max_halvings,
+                   std::span<const uint32_t> unknowns, std::span<const uint32_t> unknown_of,
+                   std::span<const uint32_t> springs, const double* step_dx);
 // Adds the membrane's point loads on unknowns to a force vector laid out 3 per unknown (mN).
 void add_point_loads(const Membrane& m, std::span<const uint32_t> unknown_of, double* force);
 }  // namespace implicit_detail

@@ -213,16 +213,16 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
   }
 
   // Δx = dt·(v + Δv); particles outside an active set do not move.
-  c.step_dx.resize(static_cast<Eigen::Index>(3 * nu));
+  c.predictor_dx.resize(static_cast<Eigen::Index>(3 * nu));
   const bool restricted = !m.active.empty();
   for (size_t u = 0; u < nu; ++u) {
     const uint32_t i = c.predictor_unknowns[u];
     const bool moves = !restricted || std::binary_search(m.active.begin(), m.active.end(), i);
     const double v[3] = {p.vx[i], p.vy[i], p.vz[i]};
-    for (int a = 0; a < 3; ++a) c.step_dx[3 * u + a] = moves ? dt * (v[a] + c.predictor_dv[3 * u + a]) : 0.0;
+    for (int a = 0; a < 3; ++a) c.predictor_dx[3 * u + a] = moves ? dt * (v[a] + c.predictor_dv[3 * u + a]) : 0.0;
   }
   const double alpha = implicit_detail::line_search(m, dt, c.settings.max_line_search_halvings, c.predictor_unknowns,
-                                                    c.predictor_unknown_of, c.predictor_springs, c.step_dx.data());
+                                                    c.predictor_unknown_of, c.predictor_springs, c.predictor_dx.data());
   c.stats.step_fraction = alpha;
   if (alpha < 1.0) ++c.stats.line_search_cuts;
 
@@ -230,7 +230,7 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
   for (size_t u = 0; u < nu; ++u) {
     const uint32_t i = c.predictor_unknowns[u];
     if (restricted && !std::binary_search(m.active.begin(), m.active.end(), i)) continue;
-    const double dx = alpha * c.step_dx[3 * u], dy = alpha * c.step_dx[3 * u + 1], dz = alpha * c.step_dx[3 * u + 2];
+    const double dx = alpha * c.predictor_dx[3 * u], dy = alpha * c.predictor_dx[3 * u + 1], dz = alpha * c.predictor_dx[3 * u + 2];
     p.vx[i] = static_cast<float>(dx / dt), p.vy[i] = static_cast<float>(dy / dt), p.vz[i] = static_cast<float>(dz / dt);
     p.x[i] = static_cast<float>(p.x[i] + dx);
     p.y[i] = static_cast<float>(p.y[i] + dy);

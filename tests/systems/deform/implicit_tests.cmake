@@ -6,3 +6,7 @@ phaco_test(test_implicit
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit_active.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit_predictor.cpp
   LIBS phaco_sys_deform phaco_sys_springs phaco_sys_active_nodes phaco_eye TBB::tbb)
+# Implicit Euler's linear solve: operator, preconditioners, threaded product (implicit_solver.cpp).
+phaco_test(test_implicit_solver
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_implicit_solver.cpp
+  LIBS phaco_sys_deform phaco_sys_springs phaco_sys_active_nodes phaco_eye TBB::tbb)

@@ -1,0 +1,210 @@
+#pragma once
+// The Eigen side of implicit Euler's linear solve (implicit.hpp): the matrix-free operator over the
+// step's block-CSR system, its product specialisation for Eigen::ConjugateGradient, and the CG
+// preconditioners. Internal to systems/deform (implicit_euler.cpp and its tests).
+//
+// Operator. A is stored as 3×3 symmetric blocks on the block-CSR pattern (row u: u and the
+// unknowns joined to it by a spring). The product gathers each row, y_u = Σ_w A_uw·x_w, in the
+// row's fixed order: rows are independent, so they split over threads (phaco::parallel_for) with
+// results bit-identical to the serial loop. It runs serially below
+// ImplicitSettings::parallel_min_unknowns: a small active set pays no threading overhead.
+//
+// Preconditioners (docs/implicit_and_active.md has the measurements). The capsule's system is a
+// membrane far stiffer in plane than out of plane (transverse stiffness is only the tension), so a
+// scalar diagonal sees neither the per-node orientation nor the long-range coupling:
+//   Jacobi              1/diag(A).
+//   BlockJacobi         the inverse of each node's 3×3 diagonal block: catches each node's
+//                       in-plane / out-of-plane anisotropy, exactly, at the cost of Jacobi.
+//   IncompleteCholesky  Eigen::IncompleteCholesky (zero fill) of the assembled A in the unknowns'
+//                       own order (sorted particles: mesh-local). Natural order converges faster
+//                       than AMD here (level 3 expert: 40.9 against 54.5 iterations per frame).
+//   TwoLevel            smoothed aggregation (Tamstorf, Jones & McCormick 2015, "Smoothed
+//                       aggregation multigrid for cloth simulation"), one level below the active
+//                       set: aggregates of neighbouring nodes (Vaněk's greedy phases over the block
+//                       graph), constant near-null space per axis, prolongator smoothed by one
+//                       damped block-Jacobi step, Galerkin coarse operator Pᵀ·A·P factorised by
+//                       sparse Cholesky; applied as a symmetric cycle (block-Jacobi pre-smooth,
+//                       coarse correction, the same post-smooth), so it is SPD and CG stays valid.
+// IncompleteCholesky is rebuilt whenever the pattern is (unknown set or topology changed) and
+// otherwise reused stale. The active set changes in almost every frame of a capsulorhexis
+// (measured: 1010 pattern builds in 1040 frames at level 3), so TwoLevel keys its prolongator by
+// particle and is rebuilt only after a topology change (invalidate()) or when more than
+// settings.two_level_rebuild_fraction of the unknowns entered or left the set since the build;
+// unknowns new since then get no coarse correction, only the smoother. Either way the result stays
+// SPD: the cycle's inverse is 2S − S·A·S + (I − S·A)·P·C·Pᵀ·(I − A·S) with S = ω·D⁻¹, SPD while
+// ω·ρ(D⁻¹A) < 2 for ANY SPD coarse solve C and any P, stale or partial; so CG converges to the same
+// tolerance, only its speed depends on staleness. D (the smoother's blocks) is refreshed every
+// step.
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <array>
+#include <span>
+#include <vector>
+
+#include "systems/deform/implicit.hpp"
+
+namespace phaco::deform::implicit_detail {
+class BlockOperator;
+}  // namespace phaco::deform::implicit_detail
+
+// Eigen reads an operator's scalar and storage types from its traits.
+template <>
+struct Eigen::internal::traits<phaco::deform::implicit_detail::BlockOperator>
+    : public Eigen::internal::traits<Eigen::SparseMatrix<double>> {};
+
+namespace phaco::deform {
+
+struct PreconditionerState {
+  Preconditioner kind = Preconditioner::Jacobi;
+  uint64_t built_for_pattern = ~uint64_t(0);  // stats.pattern_builds when factorised
+  Eigen::VectorXd inverse_diagonal;           // Jacobi: 3 per unknown
+  std::vector<Sym3> inverse_block;            // BlockJacobi and the two-level smoother: per unknown
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> incomplete_cholesky;
+  // Two-level: the smoothed prolongator P as 3×3 blocks, row by row over the unknowns it was built
+  // on (keyed by particle, so it outlives small changes of the set), the coarse factor, and the
+  // damping ω = 4/(3ρ) of the block-Jacobi smoother, ρ ≈ spectral radius of D⁻¹A at the build.
+  using Block3 = std::array<double, 9>;        // row-major 3×3
+  std::vector<uint32_t> built_particles;       // sorted: the unknowns at the build
+  std::vector<uint32_t> p_begin, p_aggregate;  // per built unknown + 1 / per block: CSR of P
+  std::vector<Block3> p_block;                 // per block of P
+  std::vector<uint32_t> p_row_of_unknown;      // per current unknown: its row of P, or kNotUnknown
+  uint64_t built_for_topology = ~uint64_t(0);  // cache.topology_changes at the build
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> coarse;
+  double smoother_weight = 0.0;
+  uint32_t aggregates = 0;
+  // Scratch of one application (the preconditioner's solve is const in Eigen's interface).
+  mutable Eigen::VectorXd residual, coarse_rhs, coarse_solution;
+};
+
+namespace implicit_detail {
+
+// y += alpha·A·x over the pattern's rows; x and y hold 3 per unknown. Parallel above
+// settings.parallel_min_unknowns, bit-identical to the serial loop.
+void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks, const double* x,
+                       double* y, double alpha, const ImplicitSettings& settings);
+
+// Writes the pattern's scalar layout into `matrix` (once per pattern) / its values (every use).
+// Unknown u owns rows 3u..3u+2; scalar row 3u+a holds 3·deg(u) entries, block by block.
+void write_matrix_pattern(const BlockPattern& pattern,
+                          Eigen::SparseMatrix<double, Eigen::RowMajor, int>& matrix);
+void write_matrix_values(const BlockPattern& pattern, std::span<const Sym3> blocks,
+                         Eigen::SparseMatrix<double, Eigen::RowMajor, int>& matrix);
+
+// Refreshes the preconditioner for this step's system: diagonal inverses every step; the
+// factorisations when the pattern was rebuilt or the choice changed. Writes system.matrix's
+// values when a factorisation needs them.
+void update_preconditioner(ImplicitCache& cache);
+
+// Step 5 of implicit_euler_step: preconditioned CG on A·Δv = b (system.rhs) from system.guess to
+// ‖A·Δv − b‖ ≤ settings.cg_tolerance·‖b‖ (Eigen's criterion), with the operator and preconditioner
+// the settings choose; writes system.dv and the CG fields of stats (not the totals). Call
+// update_preconditioner first.
+void solve_linear_system(ImplicitCache& cache);
+
+// z = B⁻¹·r, B the cache's preconditioner.
+void apply_preconditioner(const ImplicitCache& cache, const double* r, double* z);
+
+// Matrix-free A over the cache's blocks (Eigen's documented matrix-free pattern: an EigenBase with
+// a custom GEMV product, specialised below).
+class BlockOperator : public Eigen::EigenBase<BlockOperator> {
+ public:
+  using Scalar = double;
+  using RealScalar = double;
+  using StorageIndex = int;
+  enum {
+    ColsAtCompileTime = Eigen::Dynamic,
+    MaxColsAtCompileTime = Eigen::Dynamic,
+    IsRowMajor = false
+  };
+
+  explicit BlockOperator(const ImplicitCache& cache)
+      : cache_(&cache), size_(static_cast<Eigen::Index>(3 * cache.pattern.rows())) {}
+  Eigen::Index rows() const { return size_; }
+  Eigen::Index cols() const { return size_; }
+
+  template <class Rhs>
+  Eigen::Product<BlockOperator, Rhs, Eigen::AliasFreeProduct> operator*(
+      const Eigen::MatrixBase<Rhs>& x) const {
+    return Eigen::Product<BlockOperator, Rhs, Eigen::AliasFreeProduct>(*this, x.derived());
+  }
+  // dst += alpha·A·x (dst and x are CG's contiguous work vectors).
+  template <class Dst, class Rhs>
+  void add_product(Dst& dst, const Rhs& x, double alpha) const {
+    const Eigen::Ref<const Eigen::VectorXd> xr(x);
+    Eigen::Ref<Eigen::VectorXd> yr(dst);
+    add_block_product(cache_->pattern, cache_->system.block, xr.data(), yr.data(), alpha,
+                      cache_->settings);
+  }
+
+ private:
+  const ImplicitCache* cache_;
+  Eigen::Index size_;
+};
+
+// The cache's preconditioner in the shape Eigen's CG expects. Deriving from SparseSolverBase makes
+// solve() an expression that CG evaluates straight into its work vector: no allocation per
+// iteration.
+class CachePreconditioner : public Eigen::SparseSolverBase<CachePreconditioner> {
+ public:
+  using Scalar = double;
+  using RealScalar = double;
+  using StorageIndex = int;
+  enum { ColsAtCompileTime = Eigen::Dynamic, MaxColsAtCompileTime = Eigen::Dynamic };
+
+  CachePreconditioner() = default;
+  template <class M>
+  explicit CachePreconditioner(const M&) {}
+  template <class M>
+  CachePreconditioner& analyzePattern(const M&) {
+    return *this;
+  }
+  template <class M>
+  CachePreconditioner& factorize(const M&) {
+    return *this;
+  }
+  template <class M>
+  CachePreconditioner& compute(const M&) {
+    return *this;
+  }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+  void set(const ImplicitCache* cache) {
+    cache_ = cache;
+    m_isInitialized = true;
+  }
+  Eigen::Index rows() const {
+    return cache_ ? static_cast<Eigen::Index>(3 * cache_->pattern.rows()) : 0;
+  }
+  Eigen::Index cols() const { return rows(); }
+
+  template <class Rhs, class Dest>
+  void _solve_impl(const Rhs& b, Dest& x) const {
+    x.resize(b.rows());
+    const Eigen::Ref<const Eigen::VectorXd> br(b);
+    Eigen::Ref<Eigen::VectorXd> xr(x);
+    apply_preconditioner(*cache_, br.data(), xr.data());
+  }
+
+ private:
+  const ImplicitCache* cache_ = nullptr;
+};
+
+}  // namespace implicit_detail
+}  // namespace phaco::deform
+
+namespace Eigen::internal {
+
+template <class Rhs>
+struct generic_product_impl<phaco::deform::implicit_detail::BlockOperator, Rhs, SparseShape,
+                            DenseShape, GemvProduct>
+    : generic_product_impl_base<
+          phaco::deform::implicit_detail::BlockOperator, Rhs,
+          generic_product_impl<phaco::deform::implicit_detail::BlockOperator, Rhs>> {
+  template <class Dest>
+  static void scaleAndAddTo(Dest& dst, const phaco::deform::implicit_detail::BlockOperator& lhs,
+                            const Rhs& rhs, const double& alpha) {
+    lhs.add_product(dst, rhs, alpha);
+  }
+};
+
+}  // namespace Eigen::internal
