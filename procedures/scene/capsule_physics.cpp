@@ -1,6 +1,7 @@
 #include "procedures/scene/capsule_physics.hpp"
 
 #include <array>
+#include <cstdlib>
 #include <string_view>
 
 #include "components/particles.hpp"
@@ -16,9 +17,9 @@ namespace phaco {
 
 namespace {
 
-constexpr std::array<std::string_view, 7> kCapsuleMethods = {
+constexpr std::array<std::string_view, 8> kCapsuleMethods = {
     "capsule.integrator", "capsule.spring_law", "capsule.stiffness", "capsule.pretension", "capsule.active_set",
-    "capsule.cutting",    "capsule.tear_rule"};
+    "capsule.cutting",    "capsule.tear_rule",  "capsule.cg_tolerance"};
 
 
 }  // namespace
@@ -67,6 +68,16 @@ void add_capsule_physics(Scene& scene) {
   cp.dynamics.glue_stiffness_mn_mm = static_cast<float>(params.get("capsule_model.glue_stiffness_mn_mm"));
   cp.dynamics.gravity_mm_s2 = {0.0f, 0.0f, -static_cast<float>(params.get("capsule_model.gravity_mm_s2"))};
   cp.use_active_set = active == "on";
+  // The implicit step's relative CG tolerance (default ImplicitSettings'); the sweep's converged
+  // reference tightens it (perf/sweep/sweep_reference.hpp).
+  if (const auto it = scene.scenario.methods.find("capsule.cg_tolerance"); it != scene.scenario.methods.end()) {
+    char* end = nullptr;
+    const double tol = std::strtod(it->second.c_str(), &end);
+    if (end == it->second.c_str() || *end != '\0' || !(tol > 0.0 && tol < 1.0))
+      throw InputError(scene.scenario.source + ": methods[\"capsule.cg_tolerance\"]: expected a number in (0, 1), got '" +
+                       it->second + "'");
+    cp.state.implicit.settings.cg_tolerance = tol;
+  }
   cp.active_hops = static_cast<uint32_t>(params.get("capsule_model.active_hops"));
   cp.grasp.radius_mm = params.get("capsule_model.grasp_radius_mm");
   cp.wake_motion_mm = params.get("capsule_model.wake_motion_mm");
