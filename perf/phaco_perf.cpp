@@ -100,10 +100,11 @@ studies:
       --replot redraws the section and charts from DIR/results/sweep_points.json without
       measuring again (the figures stay those of the run that measured them).
       --reference makes DIR/results/sweep_reference.json instead: per drill, one run off the
-      default path (capsulorhexis: whole capsule, capsule.active_set=off, dt/2, CG tolerance 1e-8,
-      level 3; sculpting and incision: level 8, dt/4), keyed by a hash of the recipe and the input
-      files (a changed scenario makes it stale). --reference-level and --reference-dt-divisor
-      change every chosen drill's recipe. About 7 minutes on 2 cores.
+      default path at level 8 and dt_s/4 (capsulorhexis also CG tolerance 1e-8, the
+      methods key capsule.cg_tolerance), keyed by a hash of the recipe and the input files (a
+      changed scenario makes it stale). --reference-level and --reference-dt-divisor change
+      every chosen drill's recipe. See docs/perf_sweep.md for its cost and why the whole capsule
+      (capsule.active_set=off) is not in it.
   all
       foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer, sweep.
 

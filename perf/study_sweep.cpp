@@ -523,7 +523,7 @@ void run_sweep(const StudyOptions& options) {
   };
 
   // ---- The section.
-  std::string md = "## The whole trainer under load: the sweep (issue 9)\n\n";
+  std::string md = "## The whole trainer under load: the sweep (issues 9 and 17)\n\n";
   md += "Measured by `" + cmd + "`, " + load +
         (replot ? " (report redrawn by `phaco-perf sweep --replot`)" : "") +
         ". Each drill's scripted expert (`data/scenarios/<drill>_expert.json`) runs to its end at "
@@ -767,14 +767,31 @@ void run_sweep(const StudyOptions& options) {
           (fit.ok ? fmt("%.2f", fit.slope) : std::string("?")) + ", p99 as elements^" +
           (fit99.ok ? fmt("%.2f", fit99.slope) : std::string("?")) + " (1 thread, levels 0.." +
           std::to_string(max_level) + ").";
-    if (drill == "capsulorhexis")
-      md +=
-          " The typical frame grows slowly: the implicit step works on the active nodes around the "
-          "tools only (seed 003's active set), whose number depends on the tool's reach more than "
-          "on the mesh. The slow frames grow with the mesh: they are the frames where a cut or a "
-          "tear changes the topology and the physics is refreshed over the whole capsule (see the "
-          "targets' reading).";
-    else if (drill == "phaco_sculpting")
+    if (drill == "capsulorhexis") {
+      // Figures, not causes: the active set's size and the slowest system at both ends.
+      const SweepRow* lo = nullptr;
+      const SweepRow* hi = nullptr;
+      for (int l = 0; l <= max_level; ++l)
+        if (const SweepRow* p = find(drill, l, 1)) {
+          if (!lo) lo = p;
+          hi = p;
+        }
+      for (const SweepRow* p : {lo, hi == lo ? nullptr : hi}) {
+        if (!p) continue;
+        const auto& r = p->r;
+        std::string slowest;
+        double worst = -1;
+        for (const auto& sys : r.systems)
+          if (sys.max_ms > worst) worst = sys.max_ms, slowest = sys.name;
+        md += " Level " + std::to_string(r.config.level) + ": active set " +
+              f("%.0f", physics_number(r, "capsule", "active_particles_mean")) +
+              " nodes on average of " + fmt("%.0f", p->elements) +
+              "; the slowest single frame of "
+              "a system is " +
+              slowest + "'s (" + f("%.1f", worst) + " ms of the frame's max " +
+              f("%.1f", r.frame.max_ms) + " ms).";
+      }
+    } else if (drill == "phaco_sculpting")
       md +=
           " The lens is static tets; a frame is the probe's broadphase query and the removal of "
           "the tets it sweeps (seed 000 §5.3). The lens's volume is fixed, so the tets a tip of "

@@ -147,14 +147,13 @@ LevelChartFiles draw_level_charts(const std::vector<SweepRow>& rows, const fs::p
   Chart rf{.title = "Topology change cost against mesh size (1 thread)",
            .x = {.label = "elements of the drill's body", .scale = Scale::Log10},
            .y = {.label = "ms", .scale = Scale::Log10}};
-  Series mean{.name = "capsule physics refresh per cut, mean", .fit_power_law = true};
-  Series worst{
-      .name = "capsule physics refresh per cut, max", .fit_power_law = true, .dashed = true};
+  Series mean{.name = "capsule refresh, mean", .fit_power_law = true};
+  Series worst{.name = "capsule refresh, max", .fit_power_law = true, .dashed = true};
   for (const auto& g : rhexis) {
     mean.x.push_back(g.elements), mean.y.push_back(g.refresh_ms_mean);
     worst.x.push_back(g.elements), worst.y.push_back(g.refresh_ms_max);
   }
-  Series cornea{.name = "cornea_cut worst frame (cornea vertices)", .fit_power_law = true};
+  Series cornea{.name = "cornea cut, worst", .fit_power_law = true};
   for (const auto& g : incision)
     cornea.x.push_back(g.elements), cornea.y.push_back(g.cornea_cut_max_ms);
   if (!rhexis.empty() || !incision.empty()) {

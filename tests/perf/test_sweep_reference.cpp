@@ -1,5 +1,5 @@
 // The issue-17 sweep pieces: the converged reference is made off the default path and the scene
-// really runs it that way (whole capsule, smaller dt, tighter CG tolerance); its key goes stale
+// really runs it that way (finer level, smaller dt, tighter CG tolerance); its key goes stale
 // when an input changes; every point's error is taken against it; and the per-level figures
 // (CG iterations per step, speed-up, slopes, the Pareto reading) come out of the points.
 #include <gtest/gtest.h>
@@ -48,20 +48,25 @@ fs::path temp_dir(const std::string& name) {
 TEST(SweepReference, TheCapsulorhexisReferenceIsOffTheDefaultPath) {
   const ReferenceRecipe recipe = default_reference_recipe("capsulorhexis");
   const SweepPointConfig ref = reference_config(recipe, "/x/capsulorhexis_expert.json", "/cache");
-  const SweepPointConfig plain;  // what a default sweep point runs
-  EXPECT_EQ(ref.methods.at("capsule.active_set"), "off");
-  EXPECT_EQ(plain.methods.count("capsule.active_set"), 0u);  // the default: on
+  const SweepPointConfig plain;       // what a default sweep point runs
+  EXPECT_GT(ref.level, plain.level);  // finer than the default level 3
   EXPECT_GT(ref.dt_divisor, 1);
   EXPECT_EQ(plain.dt_divisor, 1);
   EXPECT_LT(std::stod(ref.methods.at("capsule.cg_tolerance")),
             deform::ImplicitSettings{}.cg_tolerance);
+  EXPECT_EQ(plain.methods.count("capsule.cg_tolerance"), 0u);
   EXPECT_FALSE(ref.haptics);
   EXPECT_EQ(ref.threads, 1);
-  // The description the report prints names each departure.
-  const std::string d = describe(recipe);
+  // The description the report prints names each departure, the whole capsule included when a
+  // recipe asks for it.
+  ReferenceRecipe whole = recipe;
+  whole.methods["capsule.active_set"] = "off";
+  const std::string d = describe(whole);
+  EXPECT_NE(d.find("level 8"), std::string::npos);
   EXPECT_NE(d.find("active_set=off"), std::string::npos);
-  EXPECT_NE(d.find("dt/"), std::string::npos);
-  EXPECT_NE(d.find("CG tolerance"), std::string::npos);
+  EXPECT_NE(d.find("dt/4"), std::string::npos);
+  EXPECT_NE(d.find("CG tolerance 1e-8"), std::string::npos);
+  EXPECT_EQ(reference_config(whole, "/x", "/c").methods.at("capsule.active_set"), "off");
 }
 
 // The scene reads the tolerance key (capsule_physics.cpp) and rejects a bad one.
