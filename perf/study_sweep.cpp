@@ -865,6 +865,10 @@ void run_sweep(const StudyOptions& options) {
   md += "\n";
   for (const std::string& drill : drills) md += pareto_md(rows, drill, kNoHaptics);
   md +=
+      "How converged each reference is, and how far the capsulorhexis's level-3 outcome moves "
+      "with the time step alone, is in docs/perf_sweep.md (\"The converged reference\"): read a "
+      "front at level 3 with that spread in mind.\n\n";
+  md +=
       "The stability maps (time step against stiffness per integrator) and OpenPhaco's membrane "
       "against Bullet's btSoftBody are in the membrane section; force propagation against "
       "dynamics, Horn against polar decomposition and the SPH search's cell order are measured on "

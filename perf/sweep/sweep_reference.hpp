@@ -63,6 +63,7 @@ struct DrillReference {
   uint64_t frames = 0;
   double wall_s = 0;
   double cg_iterations_per_step = 0;  // capsulorhexis: the reference's own solve, for the record
+  std::string load;                   // the machine's load when it was made (load_note)
 };
 
 struct ReferenceFile {
