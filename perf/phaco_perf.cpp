@@ -100,10 +100,11 @@ studies:
       --replot redraws the section and charts from DIR/results/sweep_points.json without
       measuring again (the figures stay those of the run that measured them).
       --reference makes DIR/results/sweep_reference.json instead: per drill, one run off the
-      default path at level 8 and dt_s/4 (capsulorhexis also CG tolerance 1e-8, the
-      methods key capsule.cg_tolerance), keyed by a hash of the recipe and the input files (a
-      changed scenario makes it stale). --reference-level and --reference-dt-divisor change
-      every chosen drill's recipe. See docs/perf_sweep.md for its cost and why the whole capsule
+      default path at level 8 (capsulorhexis: dt_s/4 and CG tolerance 1e-8, the methods key
+      capsule.cg_tolerance; sculpting: dt_s/16; incision: dt_s/4), keyed by a hash of the recipe
+      and the input files (a changed scenario makes it stale). --reference-level and
+      --reference-dt-divisor change every chosen drill's recipe. About 5 minutes on an idle
+      machine (11 under load). docs/perf_sweep.md says why the whole capsule
       (capsule.active_set=off) is not in it.
   all
       foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer, sweep.

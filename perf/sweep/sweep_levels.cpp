@@ -413,7 +413,8 @@ std::string why_missed_md(const std::vector<SweepRow>& rows, const std::vector<s
       std::string pre;
       if (r && r->r.physics.contains("capsule") &&
           r->r.physics["capsule"].contains("preconditioner"))
-        pre = " with the " + r->r.physics["capsule"]["preconditioner"].dump() + " preconditioner";
+        if (const auto& v = r->r.physics["capsule"]["preconditioner"]; v.is_string())
+          pre = " with the " + v.get<std::string>() + " preconditioner";
       md += "- **CG iterations at level 3**: " + f("%.1f", g->cg_per_step) + " per stepped frame" +
             pre + ", over an active set of " +
             f("%.0f", r ? physics_number(r->r, "capsule", "active_particles_mean") : kNaN) +

@@ -239,5 +239,23 @@ TEST(SweepLevels, TheParetoReadingSaysWhetherTheDefaultIsOnTheFront) {
   EXPECT_EQ(md.find("do not lie"), std::string::npos);
 }
 
+// "Why a target is missed" is made of the points' figures: the system with the slowest frame and
+// the refresh's share of the worst frame; nothing when the targets are met.
+TEST(SweepLevels, WhyMissedIsMadeOfTheFigures) {
+  SweepRow r = row_of("capsulorhexis", 3, 2, {});
+  r.r.frame = {"frame", 1.0, 10.0, 20.0, 2.0};
+  r.r.systems = {{"capsule_dynamics", 0.9, 4.0, 5.0, 1.0}, {"capsule_cut", 0.0, 0.1, 18.0, 0.1}};
+  r.r.physics["capsule_cutting"] = {{"physics_refresh_ms_max", 17.0}, {"edit_ms_max", 0.2}};
+  std::string md = why_missed_md({r}, {"capsulorhexis"}, 3, {});
+  EXPECT_NE(md.find("slowest single frame is capsule_cut (18.0 ms, 90 % of the worst frame)"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("up to 17.0 ms (85 % of the worst frame)"), std::string::npos) << md;
+  r.r.frame = {"frame", 1.0, 3.0, 6.0, 2.0};  // within 4 ms p99 and 8 ms max
+  md = why_missed_md({r}, {"capsulorhexis"}, 3, {});
+  EXPECT_EQ(md.find("slowest single frame"), std::string::npos) << md;
+  EXPECT_NE(md.find("is met"), std::string::npos) << md;
+}
+
 }  // namespace
 }  // namespace phaco::perf
