@@ -10,7 +10,8 @@
 //   phaco-perf haptics      issue 6: the 1 kHz haptic thread beside the scene, the local model
 //   phaco-perf drills       issue 7: expert and novice drills, difficulty levels, comparisons
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
-//   phaco-perf sweep        issue 9: every drill at every level, thread count and method alternative,
+//   phaco-perf sweep        issue 9: every drill at every level, thread count and method
+//   alternative,
 //                           with the haptic thread beside it; the targets; the checks CI runs
 //   phaco-perf all          every study above, in that order
 //
@@ -80,19 +81,31 @@ studies:
       scripted hands: render frame rate and frame times, simulation rate and haptic period, with
       and without rendering. About 2 minutes (quick 30 s). Needs xvfb-run.
   sweep [--max-level L] [--drill NAME]... [--replot]
-      Issue 9, the whole trainer under load: each drill's scripted expert run to its end at every
-      resolution level 0..L (default 8: 256k capsule vertices, 1.6M lens tets; quick 0..3), on 1
-      and 2 threads, each point in a process of its own with the 1 kHz haptic thread beside it;
-      and each method alternative of the scene (integrators, stiffness, layout, active set, spring
-      law; broadphase, narrowphase, lens model) at levels 1, 3, 5 (quick 1). Records frame and
-      per-system p50/p99/max, haptic period and overruns, memory and bytes per element, accuracy
-      against the finest level, state hashes; charts frame cost against mesh size (seeds' figures
-      as reference points), stacked system cost, speed against accuracy, thread scaling, haptic
-      period histograms, memory; judges the issue's targets. Checks (exit status 1 if any fails):
-      every point runs to its end, 1 and 2 threads give the same state hash, the default methods
-      never diverge and stay within their accuracy bounds. About 18 minutes (quick about 1).
+  sweep --reference [--drill NAME]... [--reference-level L] [--reference-dt-divisor K]
+      Issues 9 and 17, the whole trainer under load: each drill's scripted expert run to its end
+      at every resolution level 0..L (default 8: 256k capsule vertices, 1.6M lens tets; quick
+      0..3), on 1 and 2 threads, each point in a process of its own with the 1 kHz haptic thread
+      beside it; and each method alternative of the scene (integrators, stiffness, layout, active
+      set, spring law; broadphase, narrowphase, lens model) at levels 1, 3, 5 (quick 1). Records
+      frame and per-system p50/p99/max, CG iterations per stepped frame, physics refresh per cut,
+      the cornea's worst cut frame, the 2-thread speed-up per level, haptic period and overruns,
+      memory, and accuracy against the converged reference in DIR/results/sweep_reference.json
+      (else the source tree's perf/results; falls back, labelled "missing" or "stale", to the
+      default methods at the finest level); charts frame cost, stacked system cost, CG
+      iterations, refresh cost (log-log slopes), speed-up against level, speed against accuracy
+      (Pareto fronts), haptic period, memory; judges the issues' targets. Checks (exit status 1 if
+      any fails): every point runs to its end, 1 and 2 threads give the same state hash, the
+      default methods never diverge and stay within their accuracy bounds against the run's own
+      finest level. About 18 minutes (quick about 1).
       --replot redraws the section and charts from DIR/results/sweep_points.json without
       measuring again (the figures stay those of the run that measured them).
+      --reference makes DIR/results/sweep_reference.json instead: per drill, one run off the
+      default path at level 8 (capsulorhexis: dt_s/4 and CG tolerance 1e-8, the methods key
+      capsule.cg_tolerance; sculpting: dt_s/16; incision: dt_s/4), keyed by a hash of the recipe
+      and the input files (a changed scenario makes it stale). --reference-level and
+      --reference-dt-divisor change every chosen drill's recipe. About 5 minutes on an idle
+      machine (11 under load). docs/perf_sweep.md says why the whole capsule
+      (capsule.active_set=off) is not in it.
   all
       foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer, sweep.
 

@@ -169,7 +169,10 @@ SweepChartFiles draw_sweep_charts(const std::vector<SweepRow>& rows, const fs::p
         }
     th.series.push_back(alone);
   }
-  if (tx1 > 0) th.series.push_back(level_line("target 1.7", 1.7, tx0, tx1));
+  if (tx1 > 0) {
+    th.series.push_back(level_line("target 1.5 (levels 6-8)", 1.5, tx0, tx1));
+    th.series.push_back(level_line("floor 0.95", 0.95, tx0, tx1));
+  }
   files.threads = "sweep_threads.png";
   save_chart(th, dir / files.threads);
 

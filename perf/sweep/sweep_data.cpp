@@ -71,4 +71,25 @@ double accuracy_error_pct(const SweepPointResult& r, const SweepPointResult& ref
   return worst;
 }
 
+double physics_number(const SweepPointResult& r, const std::string& body, const std::string& k) {
+  if (!r.physics.contains(body) || !r.physics[body].contains(k) || !r.physics[body][k].is_number())
+    return std::numeric_limits<double>::quiet_NaN();
+  return r.physics[body][k].get<double>();
+}
+
+double system_cost(const SweepPointResult& r, const std::string& name, double CostSummary::*field) {
+  for (const auto& s : r.systems)
+    if (s.name == name) return s.*field;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+const SweepRow* find_row(const std::vector<SweepRow>& rows, const std::string& drill, int level,
+                         int threads, const std::string& variant) {
+  for (const auto& row : rows)
+    if (row.r.ok && row.r.config.drill == drill && row.r.config.level == level &&
+        row.r.config.threads == threads && row.r.config.variant == variant)
+      return &row;
+  return nullptr;
+}
+
 }  // namespace phaco::perf

@@ -29,6 +29,16 @@ const std::vector<std::string>& accuracy_metrics(const std::string& drill);
 double accuracy_error_pct(const SweepPointResult& r, const SweepPointResult& reference,
                           std::string* detail = nullptr);
 
+// A number from a point's physics summary (report.physics[body][key]); NaN when absent.
+double physics_number(const SweepPointResult& r, const std::string& body, const std::string& key);
+
+// A system's cost summary field (e.g. &CostSummary::max_ms); NaN when the system did not run.
+double system_cost(const SweepPointResult& r, const std::string& name, double CostSummary::*field);
+
+// The finished point of a drill at (level, threads, variant); nullptr when none.
+const SweepRow* find_row(const std::vector<SweepRow>& rows, const std::string& drill, int level,
+                         int threads, const std::string& variant = "default");
+
 // Frame-cost charts per drill, the per-system stacked cost, speed against accuracy, thread scaling,
 // haptic period histograms and bytes per element: results_dir/sweep_*.png. Returns the file names
 // written, for the markdown.

@@ -94,6 +94,10 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
   s.eye.level = config.level;
   if (!config.capsule_layout.empty()) s.eye.capsule_layout = config.capsule_layout;
   for (const auto& [k, v] : config.methods) s.methods[k] = v;
+  if (config.dt_divisor < 1)
+    throw InputError("sweep point: dt_divisor must be ≥ 1, got " +
+                     std::to_string(config.dt_divisor));
+  s.dt_s /= double(config.dt_divisor);  // the tracks are in seconds: the same motion, more frames
 
   SceneOptions options;
   options.threads = config.threads;
@@ -191,6 +195,7 @@ nlohmann::json to_json(const SweepPointConfig& c) {
           {"capsule_layout", c.capsule_layout},
           {"methods", c.methods},
           {"variant", c.variant},
+          {"dt_divisor", c.dt_divisor},
           {"haptics", c.haptics},
           {"realtime", c.realtime},
           {"warm_only", c.warm_only},
@@ -206,6 +211,7 @@ SweepPointConfig config_from_json(const nlohmann::json& j) {
   c.capsule_layout = j.at("capsule_layout");
   c.methods = j.at("methods").get<std::map<std::string, std::string>>();
   c.variant = j.at("variant");
+  c.dt_divisor = j.value("dt_divisor", 1);  // points saved before the reference had none
   c.haptics = j.at("haptics");
   c.realtime = j.at("realtime");
   c.warm_only = j.at("warm_only");

@@ -27,6 +27,8 @@ struct SweepPointConfig {
   std::string capsule_layout;                  // "" = the scenario's (curvilinear)
   std::map<std::string, std::string> methods;  // added to the scenario's "methods"
   std::string variant = "default";             // label: "default" or "key=value"
+  int dt_divisor = 1;                          // run at the scenario's dt_s / dt_divisor, same
+                                               // tracks (the converged reference's smaller step)
   bool haptics = true;                         // the 1 kHz thread beside the frames
   bool realtime = true;                        // ask SCHED_FIFO for it (mlockall is not asked:
                                                // it would count untouched mappings as resident)

@@ -1,6 +1,7 @@
 #include "procedures/scene/capsule_physics.hpp"
 
 #include <array>
+#include <cstdlib>
 #include <string_view>
 
 #include "components/particles.hpp"
@@ -16,9 +17,10 @@ namespace phaco {
 
 namespace {
 
-constexpr std::array<std::string_view, 8> kCapsuleMethods = {
-    "capsule.integrator", "capsule.spring_law", "capsule.stiffness", "capsule.pretension",
-    "capsule.active_set", "capsule.cutting",    "capsule.tear_rule", "capsule.preconditioner"};
+constexpr std::array<std::string_view, 9> kCapsuleMethods = {
+    "capsule.integrator", "capsule.spring_law",     "capsule.stiffness",
+    "capsule.pretension", "capsule.active_set",     "capsule.cutting",
+    "capsule.tear_rule",  "capsule.preconditioner", "capsule.cg_tolerance"};
 
 }  // namespace
 
@@ -98,6 +100,18 @@ void add_capsule_physics(Scene& scene) {
   CapsuleSolver solver;
   solver.forces.resize_zero(particles.slots.size());
   solver.state.implicit.settings.preconditioner = *deform::parse_preconditioner(preconditioner);
+  // The implicit step's relative CG tolerance (default ImplicitSettings'); the sweep's converged
+  // reference tightens it (perf/sweep/sweep_reference.hpp).
+  if (const auto it = scene.scenario.methods.find("capsule.cg_tolerance");
+      it != scene.scenario.methods.end()) {
+    char* end = nullptr;
+    const double tol = std::strtod(it->second.c_str(), &end);
+    if (end == it->second.c_str() || *end != '\0' || !(tol > 0.0 && tol < 1.0))
+      throw InputError(scene.scenario.source +
+                       ": methods[\"capsule.cg_tolerance\"]: expected a number in (0, 1), got '" +
+                       it->second + "'");
+    solver.state.implicit.settings.cg_tolerance = tol;
+  }
 
   cs.environment.has_lens = true;
   cs.environment.lens_radius_mm = 0.5 * params.get("lens.equatorial_diameter_mm");

@@ -200,7 +200,7 @@ void check_methods(const Scenario& s, const std::vector<BodyPart>& parts) {
           s.source + ": methods[\"" + key +
           "\"]: unknown method setting; expected one of: capsule.integrator, capsule.spring_law, "
           "capsule.stiffness, capsule.pretension, capsule.active_set, capsule.cutting, "
-          "capsule.tear_rule, lens.model, lens.broadphase, lens.narrowphase, tools.ports");
+          "capsule.tear_rule, capsule.preconditioner, capsule.cg_tolerance, lens.model, lens.broadphase, lens.narrowphase, tools.ports");
     }
     if (capsule && !has(BodyPart::Capsule)) {
       throw InputError(s.source + ": methods[\"" + key + "\"]: the " +
