@@ -97,8 +97,8 @@ struct ImplicitSettings {
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a
   // small active set pays no threading overhead. Measured (docs/implicit_and_active.md).
-  uint32_t parallel_min_unknowns = 4096;
-  uint32_t parallel_grain_unknowns = 1024;
+  uint32_t parallel_min_unknowns = 1024;
+  uint32_t parallel_grain_unknowns = 512;
   // TwoLevel: rebuild the hierarchy when more than this fraction of the unknowns entered or left
   // the set since its build (otherwise reuse it stale); a topology change always rebuilds.
   double two_level_rebuild_fraction = 0.2;
