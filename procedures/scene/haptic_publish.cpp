@@ -9,6 +9,7 @@
 #include "components/tool.hpp"
 #include "components/triangles.hpp"
 #include "engine/core/clock.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/scene.hpp"
 
@@ -23,6 +24,7 @@ void clear_tool(HapticTool& t) {
   t.spring_count = 0;
   t.triangle_count = 0;
   t.grasped_node = kHapticNoNode;
+  t.grasp_limit_mn = 0;
   t.lens_present = false;
   t.damping_mn_s_per_mm = 0;
 }
@@ -215,6 +217,11 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
       const ToolGrasp* g = scene.world.get<ToolGrasp>(e);
       const uint32_t grasped = g && g->capsule.holding() ? g->capsule.particle : kInvalidIndex;
       fill_capsule(scene, *capsule, settings, scratch, pose.pos, grasped, t);
+      // The flap of an open tear tears at the capsule's resistance: the device feels no more.
+      const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
+      if (grasped != kInvalidIndex && cc && cc->flap.tip != kInvalidIndex &&
+          !cc->tear_state.complete)
+        t.grasp_limit_mn = static_cast<float>(cc->tear.threshold_mn);
     }
     // The probe sculpts the lens on purpose (phaco_sculpting): no lens-touch force for it there.
     const bool sculpting_probe = tool.kind == ToolKind::PhacoProbe && scene.body(BodyPart::Lens);
