@@ -52,7 +52,7 @@ struct HapticTool {
 
   uint16_t grasped_node = kHapticNoNode;  // local index, or none
   // The held flap tears at this force (the capsule's tear resistance, systems/tear): the grasp's
-  // force is bounded by it. 0: no bound (nothing held, or no open tear).
+  // force is bounded by it. 0: no bound (nothing held, or no flap torn yet).
   float grasp_limit_mn = 0;
 
   // Contact patch: triangles near the tool (corners are local node indices).

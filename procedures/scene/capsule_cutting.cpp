@@ -195,15 +195,17 @@ bool cystotome_contact(Scene& scene, const cut::CutMesh& m, CapsuleCutting& cc, 
 // particle's rest distance to the tip (tear_until_below relaxes the force by the tear's advance).
 bool flap_pull(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, Vec3& pull, double& elongation) {
   unfold(m, cc);  // the fold is this frame's: a new pull direction meets the flap's own springs
-  if (cc.flap.tip == kInvalidIndex || !m.particles.slots.alive(cc.flap.tip) || cc.tear_state.complete) return false;
+  if (cc.flap.tip == kInvalidIndex || !m.particles.slots.alive(cc.flap.tip)) return false;
   for (Entity tool : scene.tools) {
     const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
     if (!g || !g->capsule.holding() || !m.particles.slots.alive(g->capsule.particle)) continue;
     const uint32_t h = g->capsule.particle, t = cc.flap.tip;
     const Vec3 at = scene.world.at<ToolState>(tool).pos;
     const double force = flap_force(m, h, at).norm();
-    cc.tearing = true, cc.flap_force_mn = force;
+    // Once the tear has closed, the held flap is the freed disc: it still folds rather than drag.
     fold_held_flap(m, cc, h, at, force);
+    if (cc.tear_state.complete) return false;
+    cc.tearing = true, cc.flap_force_mn = force;
     const Vec3 along = at - cut::particle_position(m.particles, t);
     if (along.norm() < cc.min_lever_mm) return false;
     // The flap's tension reaches the tip in the membrane's plane (a flap folded over the disc).

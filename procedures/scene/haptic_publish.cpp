@@ -217,10 +217,9 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
       const ToolGrasp* g = scene.world.get<ToolGrasp>(e);
       const uint32_t grasped = g && g->capsule.holding() ? g->capsule.particle : kInvalidIndex;
       fill_capsule(scene, *capsule, settings, scratch, pose.pos, grasped, t);
-      // The flap of an open tear tears at the capsule's resistance: the device feels no more.
+      // A held flap (or the disc it freed) folds at the tear resistance: the device feels no more.
       const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
-      if (grasped != kInvalidIndex && cc && cc->flap.tip != kInvalidIndex &&
-          !cc->tear_state.complete)
+      if (grasped != kInvalidIndex && cc && cc->flap.tip != kInvalidIndex)
         t.grasp_limit_mn = static_cast<float>(cc->tear.threshold_mn);
     }
     // The probe sculpts the lens on purpose (phaco_sculpting): no lens-touch force for it there.
