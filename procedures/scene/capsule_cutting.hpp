@@ -5,6 +5,11 @@
 // (systems/tear) from the tip of the last cystotome cut. Seed 000's f_t: the flap is a strip under
 // tension between the forceps and the tear's tip, so the pull reaches the tip along the strip — its
 // direction from the tip to the forceps, its magnitude the pull of the held particle's springs.
+// The tear is the force limit (issue 17 item 5): its threshold is the capsule's tear resistance
+// F_c = G_c·h/2 (systems/tear), and the held flap folds at F_c — the stretched springs at the held
+// particle lengthen, for this frame, until their pull is F_c — because our membrane, unlike a real
+// flap, cannot fold over and would otherwise drag the disc behind the forceps (docs/
+// cutting_and_tearing.md, "Tear forces").
 //
 // The cut runs in the capsule's rest shape (material coordinates): the membrane under the forceps
 // is stretched, sheared and folded, and a tear walked over the deformed surface meets its own
