@@ -51,6 +51,9 @@ struct HapticTool {
   float damping_mn_s_per_mm = 0;
 
   uint16_t grasped_node = kHapticNoNode;  // local index, or none
+  // The held flap tears at this force (the capsule's tear resistance, systems/tear): the grasp's
+  // force is bounded by it. 0: no bound (nothing held, or no flap torn yet).
+  float grasp_limit_mn = 0;
 
   // Contact patch: triangles near the tool (corners are local node indices).
   uint32_t triangle_count = 0;

@@ -9,6 +9,7 @@
 //                           (Hausdorff, remeshing), scripted capsulorhexis opening per level
 //   phaco-perf haptics      issue 6: the 1 kHz haptic thread beside the scene, the local model
 //   phaco-perf drills       issue 7: expert and novice drills, difficulty levels, comparisons
+//   phaco-perf tear         issue 17: forceps force on the capsulorhexis flap against time, bands
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
 //   phaco-perf sweep        issue 9: every drill at every level, thread count and method
 //   alternative,
@@ -76,6 +77,11 @@ studies:
       systems; the capsulorhexis and sculpting experts at every difficulty level of their drill
       files; every novice against its drill's expert by dynamic time warping. About 2 minutes
       (quick: one expert and one novice per drill, one level).
+  tear
+      Issue 17 item 5, tear forces: the force the forceps exert on the capsulorhexis flap per frame
+      for the scripted expert (standard, young and hard eyes) and novices, against the tissue bands
+      (expert RMS 6-14 mN, novices 17, perforation 15-35, rim 150 +- 70); the tear resistance, RMS
+      and peak while tearing, the opening. Writes results/tear_force.*. About 1 minute.
   trainer
       Issue 8, phaco-trainer under Xvfb on Mesa's software renderer at 1280x720, each drill with
       scripted hands: render frame rate and frame times, simulation rate and haptic period, with
@@ -107,7 +113,7 @@ studies:
       machine (11 under load). docs/perf_sweep.md says why the whole capsule
       (capsule.active_set=off) is not in it.
   all
-      foundation, bandwidth, membrane, cut, lens, haptics, drills, trainer, sweep.
+      foundation, bandwidth, membrane, cut, lens, haptics, drills, tear, trainer, sweep.
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -154,6 +160,8 @@ int main(int argc, char** argv) {
       perf::run_haptics(options);
     } else if (cmd == "drills") {
       perf::run_drills(options);
+    } else if (cmd == "tear") {
+      perf::run_tear(options);
     } else if (cmd == "trainer") {
       perf::run_trainer_study(options);
     } else if (cmd == "sweep") {
@@ -168,6 +176,7 @@ int main(int argc, char** argv) {
       perf::run_lens(options);
       perf::run_haptics(options);
       perf::run_drills(options);
+      perf::run_tear(options);
       perf::run_trainer_study(options);
       perf::run_sweep(options);
     } else {

@@ -22,6 +22,7 @@ void run_cut(const StudyOptions& options);
 void run_lens(const StudyOptions& options);
 void run_haptics(const StudyOptions& options);
 void run_drills(const StudyOptions& options);
+void run_tear(const StudyOptions& options);
 void run_trainer_study(const StudyOptions& options);
 void run_sweep(const StudyOptions& options);
 

@@ -23,6 +23,8 @@ void apply_difficulty(EyeParams& params, const DifficultySettings& s) {
     apply_override(params, "capsule.youngs_modulus_kpa", e);
     apply_override(params, "capsule.ultimate_stress_kpa",
                    params.get("capsule.ultimate_stress_kpa") * ratio);
+    apply_override(params, "capsule.tear_energy_j_m2",
+                   params.get("capsule.tear_energy_j_m2") * ratio);
   }
   if (s.anterior_bowing_kpa && *s.anterior_bowing_kpa > 0) {
     const double a = 0.5 * params.get("lens.equatorial_diameter_mm");

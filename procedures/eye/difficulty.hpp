@@ -8,7 +8,9 @@
 //                      10 years and 1.5 MPa at 80 (Krag, Olsen & Andreassen, IOVS 38:357, 1997:
 //                      stiffness and strength of the anterior capsule fall with age), clamped to
 //                      [1.5, 6] MPa; the ultimate stress scales with it, so the strain at which
-//                      the capsule tears stays the eye file's (tear strength falls with age).
+//                      the capsule tears stays the eye file's (tear strength falls with age); so
+//                      does the tearing energy (G_c = σ_u·δ_c, a cohesive zone of fixed critical
+//                      opening δ_c), hence the tear resistance F_c = G_c·h/2 (systems/tear).
 //   anterior_bowing_kpa a posterior (vitreous) pressure P pushing the lens diaphragm forward; the
 //                      anterior capsule, a membrane of radius R = a²/c at the lens pole (a the
 //                      equatorial radius, c the anterior half-thickness), carries Laplace's

@@ -47,6 +47,7 @@ const std::vector<std::string_view>& required_eye_keys() {
                                                      "capsule.radius_mm",
                                                      "capsule.perforation_force_mn",
                                                      "capsule.rim_strength_mn",
+                                                     "capsule.tear_energy_j_m2",
                                                      "capsule_model.prestretch",
                                                      "capsule_model.damping_per_s",
                                                      "capsule_model.viscosity_per_s",

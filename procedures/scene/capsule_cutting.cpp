@@ -22,20 +22,20 @@ namespace phaco {
 namespace {
 
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+      .count();
 }
 
-// The force the forceps exert on the flap through the particle they hold: the pull of that
-// particle's springs into the membrane, reversed (the held particle is kinematic, so the tool
-// balances it).
-Vec3 flap_force(const cut::CutMesh& m, uint32_t held) {
+// Calls f(spring, neighbour, extension, unit vector to the neighbour) for each spring of the
+// particle the forceps hold (once per neighbour), the held particle taken at `x` (systems/grasp
+// puts it at the forceps' tip in this frame's dynamics).
+template <class F>
+void for_each_held_spring(const cut::CutMesh& m, uint32_t held, const Vec3& x, F&& f) {
   std::vector<uint32_t> fan;
   const uint32_t hint = m.topology.vertex_triangle[held];
-  if (!m.triangles.slots.alive(hint)) return Vec3::Zero();
+  if (!m.triangles.slots.alive(hint)) return;
   cut::vertex_fan(m.triangles, m.topology.adjacency, hint, held, fan);
   std::vector<uint32_t> seen;
-  Vec3 pull = Vec3::Zero();
-  const Vec3 x = cut::particle_position(m.particles, held);
   for (uint32_t t : fan) {
     for (int k = 0; k < 3; ++k) {
       const uint32_t n = cut::corner(m.triangles, t, k);
@@ -46,10 +46,51 @@ Vec3 flap_force(const cut::CutMesh& m, uint32_t held) {
       const Vec3 d = cut::particle_position(m.particles, n) - x;
       const double len = d.norm();
       if (len <= 0) continue;
-      pull += m.springs.stiffness[it->second] * (len - m.springs.rest_length[it->second]) * (d / len);
+      f(it->second, n, len - m.springs.rest_length[it->second], Vec3(d / len));
     }
   }
+}
+
+// The force the forceps exert on the flap through the particle they hold: the pull of that
+// particle's springs into the membrane, reversed (the held particle is kinematic, so the tool
+// balances it).
+Vec3 flap_force(const cut::CutMesh& m, uint32_t held, const Vec3& at) {
+  Vec3 pull = Vec3::Zero();
+  for_each_held_spring(m, held, at, [&](uint32_t s, uint32_t, double ext, const Vec3& d) {
+    pull += m.springs.stiffness[s] * ext * d;
+  });
   return -pull;
+}
+
+// The held flap folds rather than pull harder than the tear resistance (issue 17 item 5). A real
+// flap is folded over the disc, so its tension reaches the tear's tip and the tear runs at F_c.
+// Our membrane's springs also carry compression and the flap cannot fold, so forceps moving along
+// the tear drag the held point over the disc (measured on the expert: 3.6 mm a quarter, every
+// spring at the held particle stretched, the force ramping at ≈ 25 mN/mm while the tear's tip
+// stays 0.2–0.3 mm from the forceps). So when the pull exceeds F_c the stretched springs at the
+// held particle take the fold: their rest lengths grow until the pull is F_c.
+// The original rest lengths are kept (cc.folded) and given back when the forceps let go: the
+// flap unfolds.
+void fold_held_flap(cut::CutMesh& m, CapsuleCutting& cc, uint32_t held, const Vec3& at,
+                    double pull_mn) {
+  if (pull_mn <= cc.tear.threshold_mn) return;
+  const double keep = cc.tear.threshold_mn / pull_mn;
+  for_each_held_spring(m, held, at, [&](uint32_t s, uint32_t n, double ext, const Vec3&) {
+    if (ext <= 0) return;
+    const uint64_t key = cut::edge_key(held, n);
+    if (std::none_of(cc.folded.begin(), cc.folded.end(),
+                     [&](const auto& f) { return f.first == key; }))
+      cc.folded.emplace_back(key, m.springs.rest_length[s]);
+    m.springs.rest_length[s] += static_cast<float>((1.0 - keep) * ext);
+  });
+}
+
+void unfold(cut::CutMesh& m, CapsuleCutting& cc) {
+  for (const auto& [key, rest] : cc.folded) {
+    const auto it = m.topology.spring_of_edge.find(key);
+    if (it != m.topology.spring_of_edge.end()) m.springs.rest_length[it->second] = rest;
+  }
+  cc.folded.clear();
 }
 
 // Brings the capsule's physics up to date after this frame's edits, touching only what they
@@ -138,8 +179,8 @@ void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& c
     const ToolState& st = scene.world.at<ToolState>(scene.tools[k]);
     if (held.held() || g->capsule.holding() || g->capsule.closed || st.grip < cs.grasp.close_at)
       continue;
-    const cut::CutPoint c =
-        cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency, cc.contact_hint, st.pos, cc.cut.snap);
+    const cut::CutPoint c = cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency,
+                                                  cc.contact_hint, st.pos, cc.cut.snap);
     cc.contact_hint = c.triangle;
     if (c.distance_mm > cs.grasp.radius_mm) continue;
     held = cut::grasp_at(m, c, cc.cut, cc.log);
@@ -147,7 +188,8 @@ void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& c
     cc.temporary_vertices += held.temporary;
   }
   for (uint32_t v : cc.log.new_particles) {
-    if (cc.rest_x.size() <= v) cc.rest_x.resize(v + 1), cc.rest_y.resize(v + 1), cc.rest_z.resize(v + 1);
+    if (cc.rest_x.size() <= v)
+      cc.rest_x.resize(v + 1), cc.rest_y.resize(v + 1), cc.rest_z.resize(v + 1);
     const Vec3 r = cut::rest_position(cc.topology, v);
     cc.rest_x[v] = float(r.x()), cc.rest_y[v] = float(r.y()), cc.rest_z[v] = float(r.z());
   }
@@ -162,8 +204,8 @@ bool cystotome_contact(Scene& scene, const cut::CutMesh& m, CapsuleCutting& cc, 
   for (Entity tool : scene.tools) {
     if (scene.world.at<Tool>(tool).kind != ToolKind::Cystotome) continue;
     const Vec3 tip = scene.world.at<ToolState>(tool).pos;
-    const cut::CutPoint c =
-        cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency, cc.contact_hint, tip, cc.cut.snap);
+    const cut::CutPoint c = cut::locate_cut_point(m.particles, m.triangles, cc.topology.adjacency,
+                                                  cc.contact_hint, tip, cc.cut.snap);
     cc.contact_hint = c.triangle;
     const uint32_t t = c.triangle;
     const Vec3 a = cut::particle_position(m.particles, m.triangles.a[t]);
@@ -185,29 +227,53 @@ bool cystotome_contact(Scene& scene, const cut::CutMesh& m, CapsuleCutting& cc, 
 
 // Seed 000's f_t: the flap is a strip under tension between the forceps and the tear's tip, so the
 // pull reaches the tip along the strip, with the magnitude of the held particle's springs' pull.
-// Closer than min_lever_mm the strip has no direction to speak of: no tear.
-bool flap_pull(Scene& scene, const cut::CutMesh& m, const CapsuleCutting& cc, Vec3& pull) {
-  if (cc.flap.tip == kInvalidIndex || !m.particles.slots.alive(cc.flap.tip) || cc.tear_state.complete) return false;
+// Forceps holding an open tear's flap are tearing (cc.tearing, cc.flap_force_mn); the flap folds at
+// the tear resistance (fold_held_flap). Closer than min_lever_mm the strip has no direction to
+// speak of: no tear. `elongation` is the strip's stretch, the forceps-to-tip distance less the held
+// particle's rest distance to the tip (tear_until_below relaxes the force by the tear's advance).
+bool flap_pull(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, Vec3& pull, double& elongation) {
+  unfold(m, cc);  // the fold is this frame's: a new pull direction meets the flap's own springs
+  if (cc.flap.tip == kInvalidIndex || !m.particles.slots.alive(cc.flap.tip)) return false;
   for (Entity tool : scene.tools) {
     const ToolGrasp* g = scene.world.get<ToolGrasp>(tool);
     if (!g || !g->capsule.holding() || !m.particles.slots.alive(g->capsule.particle)) continue;
-    const Vec3 along = scene.world.at<ToolState>(tool).pos - cut::particle_position(m.particles, cc.flap.tip);
+    const uint32_t h = g->capsule.particle, t = cc.flap.tip;
+    const Vec3 at = scene.world.at<ToolState>(tool).pos;
+    const double force = flap_force(m, h, at).norm();
+    // Once the tear has closed, the held flap is the freed disc: it still folds rather than drag.
+    fold_held_flap(m, cc, h, at, force);
+    if (cc.tear_state.complete) return false;
+    cc.tearing = true, cc.flap_force_mn = force;
+    const Vec3 along = at - cut::particle_position(m.particles, t);
     if (along.norm() < cc.min_lever_mm) return false;
-    pull = flap_force(m, g->capsule.particle).norm() * along.normalized();
+    // The flap's tension reaches the tip in the membrane's plane (a flap folded over the disc).
+    const Vec3 normal = tear::vertex_normal(m, t);
+    const Vec3 in_plane = along - along.dot(normal) * normal;
+    pull =
+        force * (in_plane.norm() > 1e-9 ? Vec3(in_plane.normalized()) : Vec3(along.normalized()));
+    const Vec3 rest(cc.rest_x[h] - cc.rest_x[t], cc.rest_y[h] - cc.rest_y[t],
+                    cc.rest_z[h] - cc.rest_z[t]);
+    elongation = along.norm() - rest.norm();
     return true;
   }
   return false;
 }
 
-// The cut and the tear run in the rest shape: positions swapped with the rest mirror (vector swaps),
-// the edits, the swap back, then each new particle placed on the deformed capsule by its origin.
-void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const Vec3& cut_at, bool pulling,
-                        const Vec3& pull) {
+// The cut and the tear run in the rest shape: positions swapped with the rest mirror (vector
+// swaps), the edits, the swap back, then each new particle placed on the deformed capsule by its
+// origin.
+void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const Vec3& cut_at,
+                        bool pulling, const Vec3& pull, double elongation) {
   Particles& p = m.particles;
   const size_t replay_from = cc.log.origins.size();
   std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
   if (cutting) cc.cut_segments += cut::cut_towards(m, cc.stroke, cut_at, cc.cut, cc.log).made;
-  if (pulling) tear::tear_step(m, cc.flap, cc.tear_state, pull, cc.tear, cc.cut, cc.log);
+  if (pulling) {
+    const tear::TearRunReport run = tear::tear_until_below(m, cc.flap, cc.tear_state, pull,
+                                                           elongation, cc.tear, cc.cut, cc.log);
+    cc.tear_steps_last_frame = run.steps;
+    cc.max_tear_steps_per_frame = std::max<uint64_t>(cc.max_tear_steps_per_frame, run.steps);
+  }
   std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
   const uint32_t n = p.slots.size();
   p.x.resize(n), p.y.resize(n), p.z.resize(n);
@@ -216,7 +282,8 @@ void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const
     double x = 0, y = 0, z = 0;
     for (int k = 0; k < 3; ++k) {
       if (o.from[k] == kInvalidIndex) continue;
-      x += o.weight[k] * p.x[o.from[k]], y += o.weight[k] * p.y[o.from[k]], z += o.weight[k] * p.z[o.from[k]];
+      x += o.weight[k] * p.x[o.from[k]], y += o.weight[k] * p.y[o.from[k]],
+          z += o.weight[k] * p.z[o.from[k]];
     }
     p.x[o.particle] = static_cast<float>(x), p.y[o.particle] = static_cast<float>(y),
     p.z[o.particle] = static_cast<float>(z);
@@ -226,9 +293,9 @@ void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const
 }  // namespace
 
 bool add_capsule_cutting(Scene& scene) {
-
   if (method_choice(scene, "capsule.cutting", "on", {"on", "off"}) == "off") return false;
-  const std::string rule = method_choice(scene, "capsule.tear_rule", "flap_force", {"flap_force", "most_stressed_spring"});
+  const std::string rule = method_choice(scene, "capsule.tear_rule", "flap_force",
+                                         {"flap_force", "most_stressed_spring"});
 
   const Entity capsule = *scene.body(BodyPart::Capsule);
   Particles& p = scene.world.at<Particles>(capsule);
@@ -240,7 +307,10 @@ bool add_capsule_cutting(Scene& scene) {
   cc.material.areal_density_kg_mm2 =
       scene.params.get("capsule.density_kg_m3") * 1e-9 * scene.params.get("capsule.thickness_mm");
   cc.topology = cut::build_topology(p, tr, sp.springs);
-  cc.tear.rule = rule == "flap_force" ? tear::TearRule::FlapForce : tear::TearRule::MostStressedSpring;
+  cc.tear.rule =
+      rule == "flap_force" ? tear::TearRule::FlapForce : tear::TearRule::MostStressedSpring;
+  cc.tear.threshold_mn = tear::tear_resistance_mn(scene.params.get("capsule.tear_energy_j_m2"),
+                                                  scene.params.get("capsule.thickness_mm"));
   double edge = 0.0;
   uint32_t counted = 0;
   for (uint32_t t = 0; t < tr.slots.size(); ++t) {
@@ -287,9 +357,12 @@ SystemDesc capsule_cut_system(Scene& scene) {
         forceps_temporary_vertices(scene, m, cc,
                                    cs);  // on the deformed capsule, where the forceps are
         Vec3 cut_at = Vec3::Zero(), pull = Vec3::Zero();
+        double elongation = 0.0;
+        cc.tearing = false, cc.flap_force_mn = 0.0, cc.tear_steps_last_frame = 0;
         const bool cutting = cystotome_contact(scene, m, cc, cut_at);
-        const bool pulling = !cutting && flap_pull(scene, m, cc, pull);
-        if (cutting || pulling) edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull);
+        const bool pulling = !cutting && flap_pull(scene, m, cc, pull, elongation);
+        if (cutting || pulling)
+          edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull, elongation);
         const double edit_ms = elapsed_ms(t0);
         cc.edit_ms_total += edit_ms;
         cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);
@@ -334,6 +407,8 @@ nlohmann::json capsule_cutting_summary(Scene& scene) {
       {"tear_rule", std::string(tear::to_string(cc->tear.rule))},
       {"tear_steps", ts.steps},
       {"tear_advances", ts.advances},
+      {"tear_resistance_mN", cc->tear.threshold_mn},
+      {"max_tear_steps_per_frame", cc->max_tear_steps_per_frame},
       {"tear_complete", ts.complete},
       {"runout_warnings", ts.count(tear::TearEvent::RunoutWarning)},
       {"radial_tearouts", ts.count(tear::TearEvent::RadialTearout)},
@@ -351,8 +426,10 @@ nlohmann::json capsule_cutting_summary(Scene& scene) {
       {"opening_complete", o.complete}};
   nlohmann::json events = nlohmann::json::array();
   for (const tear::TearEvent& e : ts.events)
-    events.push_back({{"kind", std::string(tear::to_string(e.kind))}, {"tear_step", e.step},
-                      {"radius_mm", e.radius_mm}, {"outward_angle_deg", e.outward_angle_deg}});
+    events.push_back({{"kind", std::string(tear::to_string(e.kind))},
+                      {"tear_step", e.step},
+                      {"radius_mm", e.radius_mm},
+                      {"outward_angle_deg", e.outward_angle_deg}});
   j["tear_events"] = events;
   if (o.complete) {
     j["opening_diameter_mm"] = o.diameter_mm;

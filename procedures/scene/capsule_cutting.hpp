@@ -5,6 +5,11 @@
 // (systems/tear) from the tip of the last cystotome cut. Seed 000's f_t: the flap is a strip under
 // tension between the forceps and the tear's tip, so the pull reaches the tip along the strip — its
 // direction from the tip to the forceps, its magnitude the pull of the held particle's springs.
+// The tear is the force limit (issue 17 item 5): its threshold is the capsule's tear resistance
+// F_c = G_c·h/2 (systems/tear), and the held flap folds at F_c — the stretched springs at the held
+// particle lengthen, for this frame, until their pull is F_c — because our membrane, unlike a real
+// flap, cannot fold over and would otherwise drag the disc behind the forceps (docs/
+// cutting_and_tearing.md, "Tear forces").
 //
 // The cut runs in the capsule's rest shape (material coordinates): the membrane under the forceps
 // is stretched, sheared and folded, and a tear walked over the deformed surface meets its own
@@ -62,6 +67,15 @@ struct CapsuleCutting {
   std::vector<uint64_t> source_frame;
   uint64_t source_frames = 15;
   uint64_t temporary_vertices = 0, temporary_removed = 0, temporary_kept = 0;
+  // The tear as the force limit (systems/tear, issue 17 item 5): threshold F_c = tear.threshold_mn,
+  // from capsule.tear_energy_j_m2 and the thickness. This frame: whether the held flap pulls on an
+  // open tear, its force as the tear saw it, and the steps the tear took.
+  bool tearing = false;
+  double flap_force_mn = 0.0;
+  uint32_t tear_steps_last_frame = 0;
+  uint64_t max_tear_steps_per_frame = 0;
+  // Springs (edge key) the held flap folded this frame, with their own rest lengths.
+  std::vector<std::pair<uint64_t, float>> folded;
   cut::EditLog log;              // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics patch after changes

@@ -46,6 +46,11 @@ struct HandRecord {
   std::vector<double> speed_mm_s, force_mn;
   metrics::Kinematics kinematics;
   metrics::RunningStats force;  // over the frames (not the t = 0 sample)
+  // Frames in which these forceps hold the flap of an open tear (CapsuleCutting::tearing), and the
+  // force over them: the tear's plateau (issue 17 item 5).
+  std::vector<uint8_t> tearing;
+  metrics::RunningStats tear_force;
+  double tearing_s = 0;
   // Event state.
   bool closed = false, holding = false, in_lens = false, beyond_cornea = false, breach = false;
   bool entered_eye = false;
@@ -137,6 +142,7 @@ void sample_hand(Scene& scene, DrillRecord& r, int index, double t, double dt_s)
 
   // Grasp events from the forceps' capsule grasp state (systems/grasp's hysteresis).
   double force = 0.0;
+  bool tearing = false;
   if (const ToolGrasp* g = scene.world.get<ToolGrasp>(h.tool)) {
     const bool holding = g->capsule.holding(), closed = g->capsule.closed;
     if (closed && !h.closed) {
@@ -155,6 +161,8 @@ void sample_hand(Scene& scene, DrillRecord& r, int index, double t, double dt_s)
       force =
           held_pull_mn(scene.world.at<Particles>(capsule), scene.world.at<CapsuleSprings>(capsule),
                        scene.world.at<CapsuleSettings>(capsule).dynamics.law, g->capsule.particle);
+      const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(capsule);
+      tearing = cc && cc->tearing;
     }
   }
 
@@ -200,6 +208,8 @@ void sample_hand(Scene& scene, DrillRecord& r, int index, double t, double dt_s)
   }
 
   if (dt_s > 0) h.force.add(force);
+  if (dt_s > 0 && tearing) h.tear_force.add(force), h.tearing_s += dt_s;
+  h.tearing.push_back(tearing ? 1 : 0);
   h.pos.push_back(p);
   h.speed_mm_s.push_back(speed);
   h.force_mn.push_back(force);
@@ -286,18 +296,28 @@ void hand_metrics(const Scene& scene, const DrillRecord& r, DrillReport& out,
     out.metrics[name + ".contact_force_mN.mean"] = h.force.mean;
     out.metrics[name + ".contact_force_mN.std"] = h.force.stddev();
     out.metrics[name + ".contact_force_mN.max"] = h.force.max;
+    if (h.tear_force.count > 0) {  // forceps that tore: the force over the tearing frames
+      const auto& f = h.tear_force;
+      out.metrics[name + ".tear_force_mN.rms"] = std::sqrt(f.mean * f.mean + f.variance());
+      out.metrics[name + ".tear_force_mN.mean"] = f.mean;
+      out.metrics[name + ".tear_force_mN.max"] = f.max;
+      out.metrics[name + ".tearing_s"] = h.tearing_s;
+    }
     nlohmann::json s;
     s["tool"] = std::string(to_string(h.kind));
     nlohmann::json pos = nlohmann::json::array(), speed = nlohmann::json::array(),
-                   force = nlohmann::json::array();
+                   force = nlohmann::json::array(), tearing = nlohmann::json::array();
     for (size_t i : idx) {
       pos.push_back(xyz(h.pos[i]));
       speed.push_back(h.speed_mm_s[i]);
       force.push_back(h.force_mn[i]);
+      tearing.push_back(h.tearing[i]);
     }
     s["pos_mm"] = std::move(pos);
     s["speed_mm_s"] = std::move(speed);
     s["force_mN"] = std::move(force);
+    if (h.tear_force.count > 0)
+      s["tearing"] = std::move(tearing);  // 1: holding an open tear's flap
     // Seed 000 Fig. 11: the distributions over every frame (not the decimated series).
     const std::span<const double> frames_speed(h.speed_mm_s.data() + 1, h.speed_mm_s.size() - 1);
     const std::span<const double> frames_force(h.force_mn.data() + 1, h.force_mn.size() - 1);
@@ -426,6 +446,7 @@ SystemDesc drill_metrics_system(Scene& scene) {
     h.hand = scene.world.at<Tool>(e).hand;
     h.kind = scene.world.at<Tool>(e).kind;
     h.pos.reserve(samples), h.speed_mm_s.reserve(samples), h.force_mn.reserve(samples);
+    h.tearing.reserve(samples);
     r.hands.push_back(std::move(h));
   }
   // The t = 0 sample: the tools' poses the scene starts from.

@@ -12,6 +12,9 @@
 //              mN); else a tip inside the lens's two half-ellipsoids: seed 003's k_f·d, k_f =
 //              haptic_model.lens_stiffness_mn_mm, d the depth (systems/haptic_model
 //              lens_penetration); else 0;
+//   tearing    the forceps hold the flap of an open tear (CapsuleCutting::tearing): the force over
+//              these frames gives <hand>.tear_force_mN.rms/mean/max and <hand>.tearing_s, and the
+//              series a 0/1 "tearing" per sample (issue 17 item 5: the tear's plateau);
 //   events     grasp / release / missed_grasp (the forceps' capsule grasp state), lens_contact (the
 //              tip entering the lens's half-ellipsoids), iris_contact (the tip's path crossing the
 //              iris plane z = iris.z_mm outside the pupil), corneal_stress (the tip beyond the

@@ -24,6 +24,7 @@ void clear_tool(HapticTool& t) {
   t.spring_count = 0;
   t.triangle_count = 0;
   t.grasped_node = kHapticNoNode;
+  t.grasp_limit_mn = 0;
   t.lens_present = false;
   t.damping_mn_s_per_mm = 0;
 }
@@ -258,6 +259,10 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
       const ToolGrasp* g = scene.world.get<ToolGrasp>(e);
       const uint32_t grasped = g && g->capsule.holding() ? g->capsule.particle : kInvalidIndex;
       fill_capsule(scene, *capsule, settings, scratch, pose.pos, grasped, t);
+      // A held flap (or the disc it freed) folds at the tear resistance: the device feels no more.
+      const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
+      if (grasped != kInvalidIndex && cc && cc->flap.tip != kInvalidIndex)
+        t.grasp_limit_mn = static_cast<float>(cc->tear.threshold_mn);
     }
     // The probe sculpts the lens on purpose (phaco_sculpting): no lens-touch force for it there.
     const bool sculpting_probe = tool.kind == ToolKind::PhacoProbe && scene.body(BodyPart::Lens);

@@ -506,6 +506,11 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
   s.proxy_velocity = (p - s.proxy) / dt;
   s.proxy = p;
   s.force = -kc * (dev - p) - st.coupling_damping_mn_s_per_mm * (dev_vel - s.proxy_velocity);
+  // A held flap tears rather than pull harder than its tear resistance (issue 17 item 5).
+  if (grasped < m.node_count && m.grasp_limit_mn > 0) {
+    const double mag = s.force.norm(), limit = m.grasp_limit_mn;
+    if (mag > limit) s.force *= limit / mag;
+  }
 
   // The god-object's memory: a triangle's side changes only when the proxy has gone round it —
   // clear of its plane and beside it (projection outside); over the face, the side it had holds

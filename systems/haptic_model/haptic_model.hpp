@@ -23,7 +23,8 @@
 //   3. proxy: P = argmin ½k_c|P − D|² + Σ ½ω_j·k_p·pen_j(P)² + ½k_f·d_lens(P)² over the
 //      contact planes (weights ω_j) and the lens tangent plane (Newton on its quadratic pieces,
 //      each an exact 3×3 solve, with backtracking on the energy);
-//   4. force F = −k_c·(D − P) − b_c·(V_D − V_P), clamped to the device's maximum.
+//   4. force F = −k_c·(D − P) − b_c·(V_D − V_P), clamped to the device's maximum; a grasp's at
+//      most the model's grasp_limit_mn (the held flap tears there: systems/tear's resistance).
 // A new model is crossfaded in (both models ticked, forces mixed linearly over blend_ms, the
 // output's change per tick beyond the models' own bounded by blend_max_step_mn until it has caught
 // up), so the force is continuous; a stalled simulation leaves the last model running.

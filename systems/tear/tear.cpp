@@ -28,6 +28,14 @@ std::string_view to_string(TearEvent::Kind k) {
   }
 }
 
+double tear_resistance_mn(double tear_energy_j_m2, double thickness_mm) {
+  if (!std::isfinite(tear_energy_j_m2) || !std::isfinite(thickness_mm) || tear_energy_j_m2 <= 0 ||
+      thickness_mm <= 0)
+    throw std::invalid_argument(
+        "tear_resistance_mn: the tearing energy and the thickness must be finite and positive");
+  return 0.5 * tear_energy_j_m2 * thickness_mm;  // J/m² = mN/mm; × mm = mN
+}
+
 uint32_t TearState::count(TearEvent::Kind k) const {
   return static_cast<uint32_t>(std::count_if(events.begin(), events.end(), [k](const TearEvent& e) { return e.kind == k; }));
 }
@@ -114,6 +122,7 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, 
   if (tear.rule == TearRule::FlapForce) {
     const Vec3 step = flap_force_step(x, vertex_normal(m, tip), path.direction, flap_force, tear);
     if (step.norm() == 0.0) return r;
+    r.advance_mm = step.norm();
     // The tear front runs ahead of the tip while snapping keeps the tip waiting for a good split.
     // (The membrane moves: a front left far behind by the tip's motion starts again at the tip.)
     if (!state.front_valid || (state.front - x).norm() > 4.0 * tear.max_step_mm) state.front = x;
@@ -124,6 +133,7 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, 
     const uint32_t n = most_stressed_spring_end(m, tip, tear);
     if (n == kInvalidIndex) return r;
     target = cut::particle_position(m.particles, n);
+    r.advance_mm = (target - x).norm();
   }
   const RunoutCheck check = check_runout(x, target - x, tear);
   if (check.warn && state.warning_armed) {
@@ -154,6 +164,28 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, 
     state.events.push_back({TearEvent::Completed, state.steps, std::hypot(now.x(), now.y()), check.outward_angle_deg, now});
   }
   return r;
+}
+
+TearRunReport tear_until_below(cut::CutMesh& m, cut::CutPath& path, TearState& state,
+                               const Vec3& flap_force, double elongation_mm,
+                               const TearSettings& tear, const cut::CutSettings& cut,
+                               cut::EditLog& log) {
+  TearRunReport run;
+  run.force_before_mn = run.force_after_mn = flap_force.norm();
+  const double e =
+      std::isfinite(elongation_mm) && elongation_mm > 0 ? elongation_mm : tear.max_step_mm;
+  Vec3 f = flap_force;
+  while (run.steps < tear.max_steps && run.advance_mm < tear.max_advance_mm) {
+    const TearStepReport r = tear_step(m, path, state, f, tear, cut, log);
+    run.warned |= r.warned, run.torn_out |= r.torn_out, run.completed |= r.completed;
+    if (r.advance_mm <= 0.0) break;  // below the resistance, or nothing left to tear
+    ++run.steps;
+    run.advance_mm += r.advance_mm;
+    f = flap_force * std::max(0.0, 1.0 - run.advance_mm / e);
+    run.force_after_mn = f.norm();
+    if (r.completed || state.complete || path.reached_boundary) break;
+  }
+  return run;
 }
 
 }  // namespace phaco::tear

@@ -22,6 +22,24 @@
 // RunoutWarning — once per excursion, re-armed when the direction turns back. A tip beyond the safe
 // radius is a runaway radial tear, recorded once as RadialTearout.
 //
+// The tear as the force limit (issue 17 item 5). Force-sensing forceps on porcine and human lenses
+// show the tearing force stable while the crack runs round: the flap's tension plateaus at the
+// capsule's tear resistance. We take the flap tear as a trouser tear (Rivlin & Thomas, J. Polym.
+// Sci. 10:291, 1953; the flap folded over and pulled along the tear, as in a capsulorhexis): the
+// energy balance F·2Δa = G_c·h·Δa for a crack advance Δa with inextensible legs gives the critical
+// force
+//     F_c = G_c·h / 2,
+// G_c the capsule's fracture (tearing) energy, J/m² = mN/mm, h its thickness. G_c comes from the
+// eye file (capsule.tear_energy_j_m2) and follows the patient's age with the modulus and the
+// ultimate stress (procedures/eye/difficulty: a cohesive zone, G_c = σ_u·δ_c with a fixed critical
+// opening δ_c, so G_c scales as σ_u). tear_resistance_mn gives F_c; it is the flap-force rule's
+// threshold. Once the flap force reaches it, tear_until_below runs the tear — several steps in one
+// frame if needed — until the force, relaxed by the advance, falls back below it: the flap, a strip
+// of elongation e between the forceps and the tear's tip, loses Δ of elongation when the tear
+// runs Δ toward the pull (F' = F·(1 − Δ/e)), so the tear advances about e·(1 − F_c/F) and a taut
+// flap's force cannot ramp above the plateau. (In the scene the held flap also drags the disc,
+// which no advance relieves: procedures/scene/capsule_cutting folds it at F_c.)
+//
 // Reads: the cut mesh (positions, springs, topology), the path's tip and direction, the flap force.
 // Writes: the cut mesh and path (through the cut), the TearState's events.
 #include <cstdint>
@@ -37,7 +55,7 @@ std::string_view to_string(TearRule r);
 
 struct TearSettings {
   TearRule rule = TearRule::FlapForce;
-  double threshold_mn = 10.0;       // |f_t| needed to tear (flap-force rule)
+  double threshold_mn = 10.0;       // |f_t| needed to tear (flap-force rule): the resistance F_c
   double a_mm_per_mn = 0.01;        // seed 000's a
   double b_mm = 0.05;               // seed 000's b
   double max_step_mm = 0.15;        // cap on one step's length
@@ -46,7 +64,13 @@ struct TearSettings {
   double safe_radius_mm = 3.5;      // the tear must stay inside this circle about the optical axis
   double warn_angle_deg = 30.0;     // outward turn that warns
   double warn_lookahead_mm = 0.75;  // warn if heading to cross the safe circle within this
+  double max_advance_mm = 1.0;      // tear_until_below: the most the tear runs in one frame,
+  uint32_t max_steps = 16;          // in at most this many steps
 };
+
+// F_c = G_c·h/2 (trouser tear, above), mN, from the tearing energy in J/m² (= mN/mm) and the
+// thickness in mm. Throws std::invalid_argument unless both are finite and positive.
+double tear_resistance_mn(double tear_energy_j_m2, double thickness_mm);
 
 struct TearEvent {
   enum Kind : uint8_t { RunoutWarning, RadialTearout, Completed } kind;
@@ -95,6 +119,7 @@ struct TearStepReport {
   bool warned = false;
   bool torn_out = false;
   bool completed = false;
+  double advance_mm = 0.0;  // how far the tear front moved (flap force) or the tip (spring rule)
   cut::SegmentReport segment;
 };
 
@@ -102,5 +127,20 @@ struct TearStepReport {
 // std::invalid_argument for a path without a tip or a non-finite force.
 TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, const Vec3& flap_force,
                          const TearSettings& tear, const cut::CutSettings& cut, cut::EditLog& log);
+
+// The tear as the force limit: tear steps while the flap force, relaxed by the advance so far
+// (F' = F·(1 − Δ/e), e the flap's elongation, mm), stays at or above the threshold, up to
+// max_steps and max_advance_mm. An elongation ≤ 0 or non-finite counts as max_step_mm (the flap's
+// stretch unknown: one step's advance relaxes it). Same throws as tear_step.
+struct TearRunReport {
+  uint32_t steps = 0;       // tear steps taken (each advanced the front or the tip)
+  double advance_mm = 0.0;  // total advance
+  double force_before_mn = 0.0, force_after_mn = 0.0;  // |f| in, and as relaxed by the advance
+  bool warned = false, torn_out = false, completed = false;
+};
+TearRunReport tear_until_below(cut::CutMesh& m, cut::CutPath& path, TearState& state,
+                               const Vec3& flap_force, double elongation_mm,
+                               const TearSettings& tear, const cut::CutSettings& cut,
+                               cut::EditLog& log);
 
 }  // namespace phaco::tear

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "procedures/eye/difficulty.hpp"
+#include "systems/tear/tear.hpp"
 
 namespace phaco::eye {
 namespace {
@@ -42,8 +43,34 @@ TEST(Difficulty, AgeScalesTheTearStrengthWithTheModulus) {
       p.get("capsule.ultimate_stress_kpa") / p.get("capsule.youngs_modulus_kpa"),
       standard.get("capsule.ultimate_stress_kpa") / standard.get("capsule.youngs_modulus_kpa"),
       1e-12);
-  EXPECT_EQ(changed(standard, p), (std::vector<std::string>{"capsule.ultimate_stress_kpa",
-                                                            "capsule.youngs_modulus_kpa"}));
+  EXPECT_NEAR(p.get("capsule.tear_energy_j_m2"), standard.get("capsule.tear_energy_j_m2") * ratio,
+              1e-9);
+  EXPECT_EQ(changed(standard, p),
+            (std::vector<std::string>{"capsule.tear_energy_j_m2", "capsule.ultimate_stress_kpa",
+                                      "capsule.youngs_modulus_kpa"}));
+}
+
+// The tear resistance F_c = G_c·h/2 (systems/tear) follows the age through G_c: a child's stiffer
+// capsule resists the tear more than the standard eye's, an 88-year-old's less.
+TEST(Difficulty, AYoungerStifferCapsuleHasAHigherTearResistance) {
+  const EyeParams standard = default_eye_params();
+  auto resistance = [&](double age) {
+    EyeParams p = standard;
+    DifficultySettings s;
+    s.patient_age_years = age;
+    apply_difficulty(p, s);
+    return tear::tear_resistance_mn(p.get("capsule.tear_energy_j_m2"),
+                                    p.get("capsule.thickness_mm"));
+  };
+  const double standard_fc = tear::tear_resistance_mn(standard.get("capsule.tear_energy_j_m2"),
+                                                      standard.get("capsule.thickness_mm"));
+  EXPECT_NEAR(standard_fc, 0.5 * 1500 * 0.013, 1e-9) << "the eye file's G_c = 1500 J/m², h = 13 um";
+  EXPECT_GT(resistance(10), resistance(25));
+  EXPECT_GT(resistance(25), standard_fc);
+  EXPECT_LT(resistance(88), standard_fc);
+  // In proportion to the modulus.
+  EXPECT_NEAR(resistance(10) / resistance(80),
+              capsule_modulus_for_age_kpa(10) / capsule_modulus_for_age_kpa(80), 1e-9);
 }
 
 TEST(Difficulty, BowingAddsLaplaceStrainToThePrestretch) {

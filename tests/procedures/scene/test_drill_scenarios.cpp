@@ -65,7 +65,10 @@ TEST_P(DrillScenario, MissesExactlyTheTargetsItsScriptBreaks) {
   if (c.missed.empty()) {
     EXPECT_DOUBLE_EQ(r.metrics["score"].get<double>(), 100.0) << "the expert loses no points";
   } else {
-    EXPECT_LT(r.metrics["score"].get<double>(), 90.0) << "a novice loses points";
+    // The off-centre novice scores 91.5: its opening is decentred by its hands' 0.7 mm shift
+    // (0.69 mm) since the held flap folds at the tear resistance (issue 17 item 5); when the
+    // forceps dragged the disc it was 0.83–0.89 mm and the score under 90.
+    EXPECT_LT(r.metrics["score"].get<double>(), 95.0) << "a novice loses points";
   }
 }
 

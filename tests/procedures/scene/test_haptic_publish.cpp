@@ -11,9 +11,11 @@
 
 #include "components/particles.hpp"
 #include "components/tool.hpp"
+#include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/scene.hpp"
+#include "systems/haptic_model/haptic_model.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
@@ -166,6 +168,49 @@ TEST(HapticPublish, LocalSearchesMatchWholeMeshScans) {
   }
   EXPECT_GT(compared_seeds, 5u) << "the tools come near the capsule in the demo";
   EXPECT_GT(compared_patches, 5u);
+}
+
+// Issue 17 item 5: the device feels the tear's plateau. While the expert's forceps tear the flap,
+// the published model carries the capsule's tear resistance as the grasp's limit, and the haptic
+// thread's force for the held flap stays within it however hard the device pulls; the same model
+// without the limit gives far more.
+TEST(HapticPublish, TheHeldFlapOfAnOpenTearIsFeltUpToTheTearResistance) {
+  CapturePort port;
+  const Scenario s = test::repo_scenario("capsulorhexis_expert.json");
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  o.haptics = &port;
+  auto scene = build_scene(s, o);
+  const Entity capsule = *scene->body(BodyPart::Capsule);
+  int tearing_frames = 0;
+  for (uint64_t f = 0; f < 2000 && tearing_frames < 30; ++f) {
+    step(*scene);
+    tearing_frames += scene->world.at<CapsuleCutting>(capsule).tearing;
+  }
+  ASSERT_EQ(tearing_frames, 30) << "the expert tears";
+  const CapsuleCutting& cc = scene->world.at<CapsuleCutting>(capsule);
+  const HapticTool& t = tool_in(port.slot, Hand::Left);
+  ASSERT_NE(t.grasped_node, kHapticNoNode);
+  EXPECT_FLOAT_EQ(t.grasp_limit_mn, float(cc.tear.threshold_mn));
+  EXPECT_GT(t.grasp_limit_mn, 5.0f);
+  const Vec3 held(t.x[t.grasped_node], t.y[t.grasped_node], t.z[t.grasped_node]);
+  haptic_model::HapticSettings hs;
+  for (double pull_mm : {0.5, 2.0}) {
+    double felt[2] = {0, 0};
+    for (int limited = 0; limited < 2; ++limited) {
+      auto model = std::make_unique<HapticTool>(t);
+      if (!limited) model->grasp_limit_mn = 0;
+      auto st = std::make_unique<haptic_model::HapticToolState>();
+      haptic_model::adopt_model(*model, *st, hs);
+      haptic_model::HapticForce f;
+      for (int k = 0; k < 300; ++k)
+        f = haptic_model::haptic_tick(*model, held + Vec3(0, 0, pull_mm), Vec3::Zero(), hs, *st);
+      felt[limited] = f.force_mn.norm();
+    }
+    EXPECT_LE(felt[1], cc.tear.threshold_mn + 1e-3) << pull_mm;
+    if (pull_mm >= 2.0)
+      EXPECT_GT(felt[0], 2 * cc.tear.threshold_mn) << "without the limit: felt in full";
+  }
 }
 
 TEST(HapticPublish, ATipFarFromTheCapsuleGetsNoNodes) {

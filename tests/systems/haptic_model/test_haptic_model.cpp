@@ -377,6 +377,34 @@ TEST(HapticModel, GraspForceMatchesSeriesStiffness) {
   }
 }
 
+// Issue 17 item 5: a held flap tears at the capsule's resistance, so the device feels at most that
+// (HapticTool::grasp_limit_mn); without a limit the same pull is felt in full.
+TEST(HapticModel, GraspForceIsBoundedByTheFlapsTearResistance) {
+  HapticSettings s;
+  s.coupling_stiffness_mn_per_mm = 1000;
+  auto t = blank_tool();
+  t->damping_mn_s_per_mm = 0.1f;
+  add_node(*t, 0, 0, 0, HapticNodeKind::Anchored);
+  add_node(*t, 1, 0, 0, HapticNodeKind::Grasped);
+  add_spring(*t, 0, 1, 40.0, 1.0);
+  t->grasped_node = 1;
+  const double limit = 9.75;  // the standard eye's F_c
+  for (double pull : {0.1, 0.5, 2.0}) {
+    double free_pull = 0, bounded = 0;
+    for (float g : {0.0f, float(limit)}) {
+      t->grasp_limit_mn = g;
+      auto st = fresh(*t, s);
+      HapticForce f;
+      for (int k = 0; k < 500; ++k) f = haptic_tick(*t, Vec3(1 + pull, 0, 0), Vec3::Zero(), s, *st);
+      (g > 0 ? bounded : free_pull) = f.force_mn.norm();
+      EXPECT_LT(f.force_mn.x(), 0.0) << "toward the membrane";
+    }
+    EXPECT_LE(bounded, limit + 1e-6) << pull;
+    EXPECT_NEAR(bounded, std::min(free_pull, limit), 1e-3 * limit) << pull;
+    if (pull >= 2.0) EXPECT_GT(free_pull, 2 * limit) << "the pull is well above the plateau";
+  }
+}
+
 TEST(HapticModel, ForceNeverExceedsTheDeviceMaximum) {
   HapticSettings s;
   s.coupling_stiffness_mn_per_mm = 1000;

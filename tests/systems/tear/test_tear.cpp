@@ -1,8 +1,10 @@
 // The tear rules (seed 000 flap force, seed 001 most stressed spring) and seed 004's run-out check.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "systems/tear/tear.hpp"
 #include "tests/support/grid_mesh.hpp"
@@ -113,6 +115,79 @@ TEST(TearStep, RefusesToTearWithoutACutOrWithABadForce) {
   cut::cut_towards(m, path, Vec3(1.2, 1.3, 0), {}, log);
   cut::cut_towards(m, path, Vec3(2.3, 1.6, 0), {}, log);
   EXPECT_THROW(tear_step(m, path, state, Vec3(std::nan(""), 0, 0), {}, {}, log), std::invalid_argument);
+}
+
+// The tear as the force limit (issue 17 item 5). A flap modelled as a linear strip of stiffness k
+// between the forceps and the tear's tip: the forceps move along +x by `pull_mm` a frame, the
+// force is k·(u − a) (u the forceps' travel, a the tear's advance), and each frame
+// tear_until_below runs the tear. Returns the force the forceps feel each frame once the tear has
+// started (before that frame's tear), and the frame it started at.
+struct Pulled {
+  std::vector<double> force;  // per frame from the first tear on, mN
+  double first_tear_force = 0;
+  double advance_mm = 0;
+};
+Pulled pull_flap(double pull_mm, bool several_steps) {
+  cut::test::CutSheet s = cut::test::cut_sheet(phaco::test::grid_mesh(20, 0.0), 0.0);
+  cut::CutMesh m = s.mesh();
+  cut::CutPath path;
+  cut::EditLog log;
+  cut::CutSettings cs;
+  cut::cut_towards(m, path, Vec3(2.3, 9.4, 0), cs, log);
+  cut::cut_towards(m, path, Vec3(4.0, 9.4, 0), cs, log);
+  TearSettings t;
+  t.threshold_mn = tear_resistance_mn(1500.0, 0.013);  // the standard eye's F_c ≈ 9.75 mN
+  t.safe_radius_mm = 100.0;                            // no run-out on this sheet
+  if (!several_steps) t.max_steps = 1;
+  const double k = 10.0;  // mN/mm
+  TearState state;
+  Pulled out;
+  double u = 0.0, a = 0.0;
+  bool started = false;
+  while (a < 10.0 && u < 40.0 && !state.complete) {
+    u += pull_mm;
+    const double f = k * std::max(0.0, u - a);
+    if (started) out.force.push_back(f);
+    const TearRunReport run = tear_until_below(m, path, state, Vec3(f, 0, 0), f / k, t, cs, log);
+    if (run.steps > 0 && !started) started = true, out.first_tear_force = f;
+    a += run.advance_mm;
+  }
+  out.advance_mm = a;
+  EXPECT_TRUE(cut::test::sound(s));
+  return out;
+}
+
+TEST(TearResistance, IsATrouserTearsGcTimesHOverTwo) {
+  EXPECT_NEAR(tear_resistance_mn(1500.0, 0.013), 9.75, 1e-12);  // J/m² = mN/mm
+  EXPECT_NEAR(tear_resistance_mn(3000.0, 0.013), 2 * tear_resistance_mn(1500.0, 0.013), 1e-12);
+  EXPECT_THROW(tear_resistance_mn(0.0, 0.013), std::invalid_argument);
+  EXPECT_THROW(tear_resistance_mn(1500.0, std::nan("")), std::invalid_argument);
+}
+
+TEST(TearUntilBelow, ASlowlyRisingPullTearsAtAPlateauEqualToTheResistance) {
+  const double fc = tear_resistance_mn(1500.0, 0.013);
+  const Pulled p = pull_flap(0.01, true);  // the force rises by 0.1 mN a frame
+  EXPECT_GT(p.advance_mm, 9.0) << "the tear ran along the sheet";
+  EXPECT_GE(p.first_tear_force, fc);
+  EXPECT_LT(p.first_tear_force, fc + 0.11) << "the tear starts the frame the pull reaches F_c";
+  ASSERT_GT(p.force.size(), 100u);
+  double mean = 0, peak = 0;
+  for (double f : p.force) mean += f, peak = std::max(peak, f);
+  mean /= double(p.force.size());
+  EXPECT_LE(peak, fc + 0.11) << "the force never ramps above the plateau";
+  EXPECT_NEAR(mean, fc, 0.1 * fc) << "the plateau is the resistance";
+}
+
+TEST(TearUntilBelow, AFastPullStillPlateausBecauseTheTearRunsSeveralStepsAFrame) {
+  const double fc = tear_resistance_mn(1500.0, 0.013);
+  const Pulled fast = pull_flap(0.5, true);  // 5 mN a frame: more than one step's relief
+  ASSERT_GT(fast.force.size(), 5u);
+  for (double f : fast.force) EXPECT_LE(f, fc + 5.0 + 1e-9);
+  // One step a frame (seed 000's rule alone) cannot keep up: the force ramps far above F_c.
+  const Pulled single = pull_flap(0.5, false);
+  double peak = 0;
+  for (double f : single.force) peak = std::max(peak, f);
+  EXPECT_GT(peak, 3 * fc);
 }
 
 }  // namespace
