@@ -64,7 +64,7 @@ TEST(SweepReference, TheCapsulorhexisReferenceIsOffTheDefaultPath) {
   const std::string d = describe(whole);
   EXPECT_NE(d.find("level 8"), std::string::npos);
   EXPECT_NE(d.find("active_set=off"), std::string::npos);
-  EXPECT_NE(d.find("dt/4"), std::string::npos);
+  EXPECT_NE(d.find("dt/8"), std::string::npos);
   EXPECT_NE(d.find("CG tolerance 1e-8"), std::string::npos);
   EXPECT_EQ(reference_config(whole, "/x", "/c").methods.at("capsule.active_set"), "off");
 }
