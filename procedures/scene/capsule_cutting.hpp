@@ -81,8 +81,8 @@ struct CapsuleCutting {
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics patch after changes
   // Deferred compaction: due when tail + tombstones exceed max(compact_min_springs,
   // compact_fraction × live springs); done in the next frame without topology change.
-  double compact_fraction = 0.125;
-  uint32_t compact_min_springs = 1024;
+  double compact_fraction = 0.5;
+  uint32_t compact_min_springs = 4096;
   uint64_t compactions = 0;
   double compaction_ms_total = 0.0;
   double edit_ms_total = 0.0, edit_ms_max = 0.0;        // the local edits themselves
