@@ -20,9 +20,9 @@ enum class StiffnessWeighting : uint8_t { AreaWeighted, Uniform };
 
 struct Springs {
   SlotIndex slots;
-  std::vector<uint32_t> i, j;        // particle indices, i < j
-  std::vector<float> rest_length;    // mm
-  std::vector<float> stiffness;      // Linear: mN/mm; Quadratic: mN/mm²
+  std::vector<uint32_t> i, j;      // particle indices, i < j
+  std::vector<float> rest_length;  // mm
+  std::vector<float> stiffness;    // Linear: mN/mm; Quadratic: mN/mm²
 
   template <class F>
   void for_each_column(F&& f) {
@@ -43,10 +43,14 @@ struct Springs {
 // liveness add nothing for it. The owner re-plans (compaction, sort, plan_blocks) only when the
 // tail and tombstones have grown to a fraction of the table, in a frame without topology change.
 struct SpringBlocks {
-  std::vector<uint32_t> particle_begin;  // size blocks + 1; block b owns [particle_begin[b], particle_begin[b+1])
-  std::vector<uint32_t> spring_begin;    // size blocks + 1; springs of block b: [spring_begin[b], spring_begin[b+1])
+  std::vector<uint32_t>
+      particle_begin;  // size blocks + 1; block b owns [particle_begin[b], particle_begin[b+1])
+  std::vector<uint32_t>
+      spring_begin;  // size blocks + 1; springs of block b: [spring_begin[b], spring_begin[b+1])
 
-  uint32_t count() const { return particle_begin.empty() ? 0 : static_cast<uint32_t>(particle_begin.size() - 1); }
+  uint32_t count() const {
+    return particle_begin.empty() ? 0 : static_cast<uint32_t>(particle_begin.size() - 1);
+  }
   // First spring of the unplanned tail (the planned part's end).
   uint32_t tail_begin() const { return spring_begin.empty() ? 0 : spring_begin.back(); }
 };

@@ -1,3 +1,5 @@
+// One file for now: the sweep's plan and its run (options, reference and per-level figures are
+// already in perf/sweep/); splitting the rest by job is issue 22's first item.
 // phaco-perf sweep (issue 9): the whole trainer under the harness. Each drill's scripted expert is
 // run to its end at every resolution level (0..8: up to 256k capsule vertices and 1.6M lens
 // tets), on 1 and 2 simulation threads, with the 1 kHz haptic thread ticking beside the frames;

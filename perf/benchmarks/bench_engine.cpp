@@ -1,7 +1,6 @@
 // Micro-benchmarks of the engine's own overheads: what every frame pays before any physics.
 //   build/release/perf/bench_engine --benchmark_min_time=0.2
 #include <benchmark/benchmark.h>
-
 #include <oneapi/tbb/task_arena.h>
 
 #include <string>
@@ -24,8 +23,10 @@ void BM_ExecutorFrame(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(1));
   std::vector<SystemDesc> systems;
   for (int i = 0; i < n; ++i) {
-    systems.push_back({.name = "s" + std::to_string(i), .phase = Phase::Dynamics,
-                       .writes = {"c" + std::to_string(i / 4)}, .run = [](const FrameContext&) {}});
+    systems.push_back({.name = "s" + std::to_string(i),
+                       .phase = Phase::Dynamics,
+                       .writes = {"c" + std::to_string(i / 4)},
+                       .run = [](const FrameContext&) {}});
   }
   FrameGraph graph(std::move(systems));
   Executor executor(graph, threads, AccessCheck::Off);

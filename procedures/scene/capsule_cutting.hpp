@@ -52,15 +52,16 @@ struct CapsuleCutting {
   cut::MembraneMaterial material;
   cut::CutSettings cut;
   tear::TearSettings tear;
-  double contact_mm = 0.05;      // cystotome tip this close to the capsule cuts,
-  double penetration_mm = 0.5;   // and so does one pressed up to this far through it
-  double min_lever_mm = 0.3;     // forceps this close to the tear's tip do not tear
-  uint32_t contact_hint = 0;     // where the last tool contact was located
-  cut::CutPath stroke;           // the cystotome's current path
-  cut::CutPath flap;             // the path the tear continues (the last stroke with a tip)
+  double contact_mm = 0.05;     // cystotome tip this close to the capsule cuts,
+  double penetration_mm = 0.5;  // and so does one pressed up to this far through it
+  double min_lever_mm = 0.3;    // forceps this close to the tear's tip do not tear
+  uint32_t contact_hint = 0;    // where the last tool contact was located
+  cut::CutPath stroke;          // the cystotome's current path
+  cut::CutPath flap;            // the path the tear continues (the last stroke with a tip)
   tear::TearState tear_state;
-  std::vector<float> rest_x, rest_y, rest_z;  // per particle: the rest shape, swapped in for the edits
-  std::vector<cut::GraspPoint> forceps;       // per scene tool: the temporary grasp vertex it holds
+  std::vector<float> rest_x, rest_y,
+      rest_z;                            // per particle: the rest shape, swapped in for the edits
+  std::vector<cut::GraspPoint> forceps;  // per scene tool: the temporary grasp vertex it holds
   // The cut's fresh lips (particles the cut made in the last source_frames frames): seeds of the
   // capsule's active set, so the dynamics open the cut wherever it is.
   std::vector<uint32_t> sources;
@@ -76,7 +77,7 @@ struct CapsuleCutting {
   uint64_t max_tear_steps_per_frame = 0;
   // Springs (edge key) the held flap folded this frame, with their own rest lengths.
   std::vector<std::pair<uint64_t, float>> folded;
-  cut::EditLog log;              // this frame's edits (cleared each frame)
+  cut::EditLog log;  // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics patch after changes
   // Deferred compaction: due when tail + tombstones exceed max(compact_min_springs,
@@ -85,7 +86,7 @@ struct CapsuleCutting {
   uint32_t compact_min_springs = 4096;
   uint64_t compactions = 0;
   double compaction_ms_total = 0.0;
-  double edit_ms_total = 0.0, edit_ms_max = 0.0;        // the local edits themselves
+  double edit_ms_total = 0.0, edit_ms_max = 0.0;  // the local edits themselves
 };
 
 // Adds CapsuleCutting to the capsule (after add_capsule_physics) unless methods say

@@ -102,7 +102,8 @@ void add_lens_sculpting(Scene& scene) {
   // A harder nucleus yields less to the same ultrasound (issue 7's difficulty, docs/drills.md):
   // above the standard hardness 0.5 the effective power falls as 0.5 / hardness (a brunescent
   // nucleus, hardness 1, takes half the power's reach); softer nuclei cannot exceed the set power.
-  ls.ultrasound_power *= std::min(1.0, kStandardHardness / params.get("lens_model.nucleus_hardness"));
+  ls.ultrasound_power *=
+      std::min(1.0, kStandardHardness / params.get("lens_model.nucleus_hardness"));
   const double f = params.get("lens.nucleus_fraction");
   ls.nucleus = {f * 0.5 * params.get("lens.equatorial_diameter_mm"),
                 f * params.get("lens.anterior_half_thickness_mm"),

@@ -15,8 +15,8 @@
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
-#include "procedures/scene/cornea_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/cornea_cutting.hpp"
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
@@ -200,7 +200,8 @@ void check_methods(const Scenario& s, const std::vector<BodyPart>& parts) {
           s.source + ": methods[\"" + key +
           "\"]: unknown method setting; expected one of: capsule.integrator, capsule.spring_law, "
           "capsule.stiffness, capsule.pretension, capsule.active_set, capsule.cutting, "
-          "capsule.tear_rule, capsule.preconditioner, capsule.cg_tolerance, lens.model, lens.broadphase, lens.narrowphase, tools.ports");
+          "capsule.tear_rule, capsule.preconditioner, capsule.cg_tolerance, lens.model, "
+          "lens.broadphase, lens.narrowphase, tools.ports");
     }
     if (capsule && !has(BodyPart::Capsule)) {
       throw InputError(s.source + ": methods[\"" + key + "\"]: the " +
@@ -236,7 +237,9 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
                        for (Entity e : scene.tools) {
                          // A device replaces the track of its hand (DESIGN.md §7).
                          ToolState& pose = scene.world.at<ToolState>(e);
-                         if (scene.haptics && scene.haptics->newest_pose(scene.world.at<Tool>(e).hand, pose)) continue;
+                         if (scene.haptics &&
+                             scene.haptics->newest_pose(scene.world.at<Tool>(e).hand, pose))
+                           continue;
                          tool_motion::move_tool(scene.world.at<ToolTrack>(e), pose, t_end);
                        }
                      }});
@@ -273,7 +276,8 @@ nlohmann::json drill_setup_json(const Scene& scene) {
   nlohmann::json settings = nlohmann::json::object();
   if (d.patient_age_years) settings["patient_age_years"] = *d.patient_age_years;
   if (d.anterior_bowing_kpa) settings["anterior_bowing_kpa"] = *d.anterior_bowing_kpa;
-  if (d.anterior_chamber_depth_mm) settings["anterior_chamber_depth_mm"] = *d.anterior_chamber_depth_mm;
+  if (d.anterior_chamber_depth_mm)
+    settings["anterior_chamber_depth_mm"] = *d.anterior_chamber_depth_mm;
   if (d.nucleus_hardness) settings["nucleus_hardness"] = *d.nucleus_hardness;
   return {{"file", scene.drill.source},
           {"title", scene.drill.title},
@@ -357,7 +361,8 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   for (SystemDesc& s : systems)
     if (s.name == "apply_commands") s.barrier = records, s.reads = {"world.commands"};
   scene->graph = std::make_unique<FrameGraph>(std::move(systems));
-  scene->executor = std::make_unique<Executor>(*scene->graph, options.threads, options.access_check);
+  scene->executor =
+      std::make_unique<Executor>(*scene->graph, options.threads, options.access_check);
   return scene;
 }
 

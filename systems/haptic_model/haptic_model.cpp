@@ -1,5 +1,7 @@
 // The haptic thread's local force model: see haptic_model.hpp and docs/haptic_model.md.
 // Everything here works on the fixed arrays of HapticToolState: no allocation, no lock, no throw.
+// One file because every part (proxy, implicit local nodes, grasp, lens, coupling, crossfade) is
+// one tick's pipeline over the same state; splitting it by job is left to issue 22.
 #include "systems/haptic_model/haptic_model.hpp"
 
 #include <algorithm>
