@@ -88,7 +88,9 @@ Bound bound_of(const std::string& drill) {
 }
 
 // Points of the default methods without the haptic thread beside them (thread scaling).
-constexpr const char* kNoHaptics = "no haptic thread";
+constexpr const char* kNoHaptics = kNoHapticsVariant;
+// ... and with the executor's flow graph every frame instead of its Auto dispatch.
+constexpr const char* kGraphEveryFrame = kGraphEveryFrameVariant;
 
 std::string key(const SweepPointConfig& c) {
   return c.drill + "/" + std::to_string(c.level) + "/" + c.variant;
@@ -348,6 +350,10 @@ void run_sweep(const StudyOptions& options) {
                              .variant = kNoHaptics,
                              .haptics = false,
                              .cache_dir = cache};
+          plan.push_back(c);
+          c.variant = kGraphEveryFrame;
+          c.haptics = true;
+          c.graph_every_frame = true;
           plan.push_back(c);
         }
       }
@@ -830,7 +836,7 @@ void run_sweep(const StudyOptions& options) {
       "fallbacks | note |\n|---|---|---:|---|---:|---:|---|---|\n";
   for (const auto& row : rows) {
     const auto& r = row.r;
-    if (r.config.threads != 1 || r.config.variant == kNoHaptics) continue;
+    if (r.config.threads != 1 || is_scaling_variant(r.config.variant)) continue;
     const bool is_variant_level = std::find(variant_levels.begin(), variant_levels.end(),
                                             r.config.level) != variant_levels.end();
     if (r.config.variant == "default" &&
@@ -879,9 +885,11 @@ void run_sweep(const StudyOptions& options) {
 
   md += "### Thread scaling\n\n![threads](results/" + charts.threads + ")\n\n";
   md +=
-      "Dots: the same speed-up without the haptic thread beside the frames. The same figures "
+      "Dots: the same speed-up without the haptic thread beside the frames, and with the "
+      "executor's flow graph every frame instead of its Auto dispatch. The same figures "
       "against the level are in the issue-17 per-level charts above; what the figures show where "
       "a target is missed is in the targets' reading.\n\n";
+  md += frame_dispatch_md(rows, drills);
   md += "### Haptic period under load\n\n![haptic period](results/" + charts.haptics + ")\n\n";
   md += "### Memory per element\n\n![memory](results/" + charts.memory + ")\n\n";
   for (const std::string& drill : drills) {

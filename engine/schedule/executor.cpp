@@ -27,6 +27,9 @@ constexpr bool kCheckAccessByDefault = true;
 // Enough for a minute at 120 Hz before any timing vector grows.
 constexpr size_t kInitialFrameCapacity = 8192;
 
+// Dispatch::Auto's moving average of a system's time: about the last eight frames.
+constexpr double kCostSmoothing = 1.0 / 8.0;
+
 using Clock = std::chrono::steady_clock;
 using Node = tbb::flow::continue_node<tbb::flow::continue_msg>;
 
@@ -68,6 +71,7 @@ struct Executor::Impl {
   // (which waits inside the arena), the arena last.
   const FrameGraph& graph;
   int threads;
+  ExecutorSettings settings;
   // oneTBB caps workers at the core count; asking for more threads than cores (a determinism
   // test on 4 threads on a 2-core machine) must really get them, so the cap is raised while
   // this executor lives.
@@ -82,8 +86,57 @@ struct Executor::Impl {
   std::vector<DeclaredAccess> declared;  // per system, where access is checked
   FrameContext ctx;  // the running frame's context; written before any node is released
 
-  Impl(const FrameGraph& g, int n)
-      : graph(g), threads(n), parallelism(raise_parallelism(n)), arena(n) {}
+  // Dispatch: a topological order for serial frames, each system's smoothed cost (written only by
+  // the node that runs it), and the critical path's scratch, sized once.
+  std::vector<uint32_t> order;
+  std::vector<double> cost_ms;
+  std::vector<double> finish_ms;
+  bool costs_known = false;
+  uint64_t graph_frames = 0;
+  uint64_t serial_frames = 0;
+
+  Impl(const FrameGraph& g, int n, const ExecutorSettings& s)
+      : graph(g), threads(n), settings(s), parallelism(raise_parallelism(n)), arena(n) {}
+
+  // Kahn's algorithm, lowest index first: `after` may point backwards, so graph order is not
+  // always a topological one.
+  void build_order() {
+    std::vector<uint32_t> waiting = graph.predecessor_counts();
+    order.clear();
+    for (size_t i = 0; i < graph.size(); ++i)
+      if (waiting[i] == 0) order.push_back(static_cast<uint32_t>(i));
+    for (size_t k = 0; k < order.size(); ++k) {
+      for (uint32_t s : graph.successors()[order[k]])
+        if (--waiting[s] == 0) order.push_back(s);
+    }
+    cost_ms.assign(graph.size(), 0.0);
+    finish_ms.assign(graph.size(), 0.0);
+  }
+
+  // Whether this frame goes through the flow graph (see Dispatch).
+  bool use_graph() {
+    switch (settings.dispatch) {
+      case Dispatch::Graph:
+        return true;
+      case Dispatch::Serial:
+        return false;
+      case Dispatch::Auto:
+        break;
+    }
+    if (threads < 2) return false;
+    if (!costs_known) return true;
+    // Longest path through the graph weighted by each system's smoothed cost; the rest of the
+    // work is what a second thread could take off the frame.
+    double total = 0, critical = 0;
+    std::fill(finish_ms.begin(), finish_ms.end(), 0.0);
+    for (uint32_t i : order) {
+      const double done = finish_ms[i] + cost_ms[i];
+      total += cost_ms[i];
+      critical = std::max(critical, done);
+      for (uint32_t s : graph.successors()[i]) finish_ms[s] = std::max(finish_ms[s], done);
+    }
+    return total - critical > settings.dispatch_cost_ms;
+  }
 
   static std::unique_ptr<tbb::global_control> raise_parallelism(int n) {
     const auto limit =
@@ -109,18 +162,28 @@ struct Executor::Impl {
     const AccessScopeGuard scope(declared.empty() ? nullptr : &declared[i]);
     const Clock::time_point t0 = Clock::now();
     s.run(ctx);
-    // Only node i touches timings[i], and once per frame, so no lock is needed.
-    timings[i].samples_ms.push_back(elapsed_ms(t0, Clock::now()));
+    // Only node i touches timings[i] and cost_ms[i], once per frame, so no lock is needed.
+    const float ms = elapsed_ms(t0, Clock::now());
+    timings[i].samples_ms.push_back(ms);
+    cost_ms[i] = costs_known ? cost_ms[i] + kCostSmoothing * (ms - cost_ms[i]) : ms;
   }
 };
 
-Executor::Executor(const FrameGraph& graph, int threads, AccessCheck check) {
+Executor::Executor(const FrameGraph& graph, int threads, AccessCheck check)
+    : Executor(graph, threads, ExecutorSettings{.access_check = check}) {}
+
+Executor::Executor(const FrameGraph& graph, int threads, const ExecutorSettings& settings) {
   if (threads < 1) {
     throw std::invalid_argument("Executor: threads must be at least 1, got " +
                                 std::to_string(threads));
   }
-  impl_ = std::make_unique<Impl>(graph, threads);
+  if (!(settings.dispatch_cost_ms >= 0)) {
+    throw std::invalid_argument("Executor: dispatch_cost_ms must be finite and >= 0");
+  }
+  impl_ = std::make_unique<Impl>(graph, threads, settings);
   Impl& im = *impl_;
+  im.build_order();
+  const AccessCheck check = settings.access_check;
   const bool checking =
       check == AccessCheck::On || (check == AccessCheck::BuildDefault && kCheckAccessByDefault);
   if (checking) {
@@ -175,6 +238,22 @@ void Executor::run_frame(const FrameContext& ctx) {
   Impl& im = *impl_;
   const Clock::time_point t0 = Clock::now();
   im.ctx = ctx;
+  if (!im.use_graph()) {
+    ++im.serial_frames;
+    // Inside the arena, so that a system's parallel loops still reach its workers.
+    im.arena.execute([&im] {
+      try {
+        for (uint32_t i : im.order) im.run_system(i);
+      } catch (...) {
+        if (im.tracker) im.tracker->clear();
+        throw;
+      }
+    });
+    im.costs_known = true;
+    im.frame.samples_ms.push_back(elapsed_ms(t0, Clock::now()));
+    return;
+  }
+  ++im.graph_frames;
   im.arena.execute([&im] {
     for (uint32_t r : im.roots) im.nodes[r]->try_put(tbb::flow::continue_msg());
     try {
@@ -186,6 +265,7 @@ void Executor::run_frame(const FrameContext& ctx) {
       throw;
     }
   });
+  im.costs_known = true;
   im.frame.samples_ms.push_back(elapsed_ms(t0, Clock::now()));
 }
 
@@ -194,6 +274,12 @@ int Executor::threads() const {
 }
 bool Executor::checks_access() const {
   return impl_->tracker.has_value();
+}
+uint64_t Executor::graph_frames() const {
+  return impl_->graph_frames;
+}
+uint64_t Executor::serial_frames() const {
+  return impl_->serial_frames;
 }
 const FrameGraph& Executor::graph() const {
   return impl_->graph;

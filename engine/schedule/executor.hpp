@@ -26,11 +26,34 @@ struct SystemTiming {
 // BuildDefault: on when engine/schedule was compiled without NDEBUG.
 enum class AccessCheck : uint8_t { BuildDefault, On, Off };
 
+// How a frame's systems reach the threads.
+//   Graph:  the flow graph; independent systems run side by side.
+//   Serial: one topological order on the calling thread (parallel loops inside a system still
+//           use the arena's workers).
+//   Auto:   Graph while the systems' costs are unknown (the first frames) or while running the
+//           independent branches side by side is predicted to save more than dispatch_cost_ms;
+//           otherwise Serial. The prediction is the work off the critical path, from a moving
+//           average of each system's time. Handing a 20 us system to a sleeping worker costs
+//           more than it saves, and a frame that is one long system gains nothing from it.
+// Any topological order gives the same state (frame_graph.hpp), so the choice never changes a
+// result, only where the time goes.
+enum class Dispatch : uint8_t { Auto, Graph, Serial };
+
+struct ExecutorSettings {
+  AccessCheck access_check = AccessCheck::BuildDefault;
+  Dispatch dispatch = Dispatch::Auto;
+  // What waking a worker and handing it a branch costs, ms (measured on the 2-core CI machine:
+  // perf/RESULTS.md, "Frame dispatch").
+  double dispatch_cost_ms = 0.05;
+};
+
 class Executor {
  public:
   // threads >= 1 (std::invalid_argument otherwise). The graph must outlive the executor.
   Executor(const FrameGraph& graph, int threads, AccessCheck check = AccessCheck::BuildDefault);
+  Executor(const FrameGraph& graph, int threads, const ExecutorSettings& settings);
   Executor(FrameGraph&&, int, AccessCheck = AccessCheck::BuildDefault) = delete;
+  Executor(FrameGraph&&, int, const ExecutorSettings&) = delete;
   ~Executor();
   Executor(const Executor&) = delete;
   Executor& operator=(const Executor&) = delete;
@@ -42,6 +65,9 @@ class Executor {
 
   int threads() const;
   bool checks_access() const;
+  // Frames run through the flow graph and serially so far (Auto's choices; for the harness).
+  uint64_t graph_frames() const;
+  uint64_t serial_frames() const;
   const FrameGraph& graph() const;
 
   const std::vector<SystemTiming>& timings() const;  // one per system, in graph order

@@ -120,7 +120,7 @@ SweepChartFiles draw_sweep_charts(const std::vector<SweepRow>& rows, const fs::p
     std::set<std::string> variants;
     for (const auto& row : rows)
       if (row.r.ok && row.r.config.drill == drill && row.r.config.threads == 1)
-        if (row.r.config.variant != "no haptic thread") variants.insert(row.r.config.variant);
+        if (!is_scaling_variant(row.r.config.variant)) variants.insert(row.r.config.variant);
     if (variants.size() > 1) {
       Chart pa{.title = drill + ": speed against accuracy (1 thread)",
                .x = {.label = "mean frame time (ms)", .scale = Scale::Log10},
@@ -147,27 +147,27 @@ SweepChartFiles draw_sweep_charts(const std::vector<SweepRow>& rows, const fs::p
            .y = {.label = "speed-up (1-thread mean / 2-thread mean)", .min = 0.0, .max = 2.2}};
   double tx0 = 1e300, tx1 = 0;
   for (const std::string& drill : kDrills) {
-    const auto one = select(rows, drill, 1), two = select(rows, drill, 2);
-    Series s{.name = drill};
-    for (const auto* a : one)
-      for (const auto* b : two)
-        if (a->r.config.level == b->r.config.level && b->r.frame.mean_ms > 0) {
-          s.x.push_back(a->elements);
-          s.y.push_back(a->r.frame.mean_ms / b->r.frame.mean_ms);
-          tx0 = std::min(tx0, a->elements), tx1 = std::max(tx1, a->elements);
-        }
+    // 1-thread frame mean over the 2-thread one, per level both ran, for one variant.
+    auto speedups = [&](const std::string& variant, Series s) {
+      for (const auto* a : select(rows, drill, 1, variant))
+        for (const auto* b : select(rows, drill, 2, variant))
+          if (a->r.config.level == b->r.config.level && b->r.frame.mean_ms > 0) {
+            s.x.push_back(a->elements);
+            s.y.push_back(a->r.frame.mean_ms / b->r.frame.mean_ms);
+          }
+      return s;
+    };
+    const Series s = speedups("default", {.name = drill});
+    for (double x : s.x) tx0 = std::min(tx0, x), tx1 = std::max(tx1, x);
     th.series.push_back(s);
-    // The same without the haptic thread beside the frames (default level and the largest).
-    const auto one_alone = select(rows, drill, 1, "no haptic thread"),
-               two_alone = select(rows, drill, 2, "no haptic thread");
-    Series alone{.name = drill + ", no haptic thread", .style = Style::Scatter};
-    for (const auto* a : one_alone)
-      for (const auto* b : two_alone)
-        if (a->r.config.level == b->r.config.level && b->r.frame.mean_ms > 0) {
-          alone.x.push_back(a->elements);
-          alone.y.push_back(a->r.frame.mean_ms / b->r.frame.mean_ms);
-        }
-    th.series.push_back(alone);
+    // The same without the haptic thread beside the frames (default level and the largest), and
+    // with the flow graph every frame (the executor before its Auto dispatch).
+    th.series.push_back(speedups(kNoHapticsVariant,
+                                 {.name = drill + ", no haptic thread", .style = Style::Scatter}));
+    const Series graph =
+        speedups(kGraphEveryFrameVariant,
+                 {.name = drill + ", flow graph every frame", .style = Style::Scatter});
+    if (!graph.x.empty()) th.series.push_back(graph);
   }
   if (tx1 > 0) {
     th.series.push_back(level_line("target 1.5 (levels 6-8)", 1.5, tx0, tx1));

@@ -18,6 +18,15 @@ struct SweepRow {
   std::string error_detail;  // which metric is furthest off, e.g. "rhexis.diameter_mm 5.31 vs 5.33"
 };
 
+// The thread-scaling variants: the default methods without the haptic thread, and with the
+// executor's flow graph every frame. They measure threads, not methods, so speed-against-accuracy
+// fronts and method tables leave them out.
+inline constexpr const char* kNoHapticsVariant = "no haptic thread";
+inline constexpr const char* kGraphEveryFrameVariant = "flow graph every frame";
+inline bool is_scaling_variant(const std::string& v) {
+  return v == kNoHapticsVariant || v == kGraphEveryFrameVariant;
+}
+
 // The drill's own element count for the charts' x axis.
 double drill_elements(const SweepPointResult& r);
 const char* drill_elements_name(const std::string& drill);

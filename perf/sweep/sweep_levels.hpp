@@ -78,4 +78,11 @@ std::string issue17_targets_md(const std::vector<SweepRow>& rows,
 std::string why_missed_md(const std::vector<SweepRow>& rows, const std::vector<std::string>& drills,
                           int max_level, const std::vector<SweepRow>& baseline_rows);
 
+// Thread scaling by dispatch, per drill at the levels the scaling variants ran: the 2-thread
+// speed-up of the frame mean with the executor's Auto dispatch, with the flow graph every frame,
+// and without the haptic thread, and the share of 2-thread frames Auto ran serially (markdown
+// table; "" when no scaling variant ran).
+std::string frame_dispatch_md(const std::vector<SweepRow>& rows,
+                              const std::vector<std::string>& drills);
+
 }  // namespace phaco::perf

@@ -101,6 +101,7 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
 
   SceneOptions options;
   options.threads = config.threads;
+  options.dispatch = config.graph_every_frame ? Dispatch::Graph : Dispatch::Auto;
   if (!config.cache_dir.empty()) options.cache_dir = config.cache_dir;
 
   std::unique_ptr<HapticSession> session;
@@ -171,6 +172,8 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
   r.sim_s = scene->time_s;
   r.frame = summarise(scene->executor->frame_timing());
   r.frame.name = "frame";
+  r.graph_frames = scene->executor->graph_frames();
+  r.serial_frames = scene->executor->serial_frames();
   for (const auto& t : scene->executor->timings()) r.systems.push_back(summarise(t));
   const RunReport report = report_of(*scene);
   for (const auto& [k, v] : report.elements) {
@@ -197,6 +200,7 @@ nlohmann::json to_json(const SweepPointConfig& c) {
           {"variant", c.variant},
           {"dt_divisor", c.dt_divisor},
           {"haptics", c.haptics},
+          {"graph_every_frame", c.graph_every_frame},
           {"realtime", c.realtime},
           {"warm_only", c.warm_only},
           {"cache_dir", c.cache_dir.string()}};
@@ -213,6 +217,7 @@ SweepPointConfig config_from_json(const nlohmann::json& j) {
   c.variant = j.at("variant");
   c.dt_divisor = j.value("dt_divisor", 1);  // points saved before the reference had none
   c.haptics = j.at("haptics");
+  c.graph_every_frame = j.value("graph_every_frame", false);  // points saved before it existed
   c.realtime = j.at("realtime");
   c.warm_only = j.at("warm_only");
   c.cache_dir = j.at("cache_dir").get<std::string>();
@@ -231,6 +236,8 @@ nlohmann::json to_json(const SweepPointResult& r) {
           {"mesh_load_s", r.mesh_load_s},
           {"frame", cost_json(r.frame)},
           {"systems", systems},
+          {"graph_frames", r.graph_frames},
+          {"serial_frames", r.serial_frames},
           {"haptic_fifo", r.haptic_fifo},
           {"haptic_detail", r.haptic_detail},
           {"haptic_ticks", r.haptic_ticks},
@@ -264,6 +271,8 @@ SweepPointResult result_from_json(const nlohmann::json& j) {
   r.mesh_load_s = j.at("mesh_load_s");
   r.frame = cost_from(j.at("frame"));
   for (const auto& s : j.at("systems")) r.systems.push_back(cost_from(s));
+  r.graph_frames = j.value("graph_frames", uint64_t{0});
+  r.serial_frames = j.value("serial_frames", uint64_t{0});
   r.haptic_fifo = j.at("haptic_fifo");
   r.haptic_detail = j.at("haptic_detail");
   r.haptic_ticks = j.at("haptic_ticks");

@@ -30,6 +30,7 @@ struct SweepPointConfig {
   int dt_divisor = 1;                          // run at the scenario's dt_s / dt_divisor, same
                                                // tracks (the converged reference's smaller step)
   bool haptics = true;                         // the 1 kHz thread beside the frames
+  bool graph_every_frame = false;              // Dispatch::Graph instead of Auto (executor.hpp)
   bool realtime = true;                        // ask SCHED_FIFO for it (mlockall is not asked:
                                                // it would count untouched mappings as resident)
   bool warm_only = false;                      // build the scene (fills the mesh cache), no steps
@@ -49,6 +50,8 @@ struct SweepPointResult {
   double sim_s = 0, wall_s = 0, mesh_load_s = 0;
   CostSummary frame;
   std::vector<CostSummary> systems;
+  // Frames the executor sent through the flow graph and ran serially (Dispatch::Auto's choice).
+  uint64_t graph_frames = 0, serial_frames = 0;
   // Haptic thread while the frames ran.
   bool haptic_fifo = false;
   std::string haptic_detail;

@@ -361,8 +361,9 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   for (SystemDesc& s : systems)
     if (s.name == "apply_commands") s.barrier = records, s.reads = {"world.commands"};
   scene->graph = std::make_unique<FrameGraph>(std::move(systems));
-  scene->executor =
-      std::make_unique<Executor>(*scene->graph, options.threads, options.access_check);
+  scene->executor = std::make_unique<Executor>(
+      *scene->graph, options.threads,
+      ExecutorSettings{.access_check = options.access_check, .dispatch = options.dispatch});
   return scene;
 }
 

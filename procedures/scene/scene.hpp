@@ -42,6 +42,8 @@ struct SceneOptions {
   // Whether the executor checks, while systems run, that they touch only what they declared and
   // never race (engine/schedule/executor.hpp). BuildDefault: on in debug builds.
   AccessCheck access_check = AccessCheck::BuildDefault;
+  // How frames reach the threads (engine/schedule/executor.hpp); Auto unless a study compares.
+  Dispatch dispatch = Dispatch::Auto;
 };
 
 struct Scene {
@@ -58,7 +60,7 @@ struct Scene {
   std::unique_ptr<Executor> executor;
   uint64_t frame = 0;
   double time_s = 0;
-  double mesh_load_s = 0;  // wall time to load or build the meshes
+  double mesh_load_s = 0;         // wall time to load or build the meshes
   HapticPort* haptics = nullptr;  // from SceneOptions
 
   std::optional<Entity> body(BodyPart part) const;

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -11,6 +12,7 @@
 #include "tests/engine/schedule/alloc_counter.hpp"
 #include "tests/engine/schedule/make_system.hpp"
 #include "tests/engine/schedule/random_systems.hpp"
+#include "tests/support/environment.hpp"
 
 namespace phaco {
 namespace {
@@ -32,49 +34,51 @@ struct RunLog {
 };
 
 TEST(Executor, RunsEverySystemOnceAfterAllItsPredecessors) {
-  for (int threads : {1, 2, 4}) {
-    for (uint64_t seed : {11u, 12u}) {
-      auto systems = test::random_systems(30, 8, seed);
-      RunLog log(systems.size());
-      // Registration index -> log slot; the graph reorders, so the run closure keeps its slot.
-      for (size_t k = 0; k < systems.size(); ++k) {
-        systems[k].run = [&log, k](const FrameContext& ctx) {
-          log.start[k] = ++log.ticket;
-          log.frame_seen[k] = ctx.frame;
-          std::this_thread::yield();  // widen the window in which a wrong order would show
-          ++log.runs[k];
-          log.end[k] = ++log.ticket;
-        };
-      }
-      const FrameGraph graph(systems);
-      std::vector<size_t> slot(graph.size());  // graph index -> registration index
-      for (size_t i = 0; i < graph.size(); ++i)
-        slot[i] = std::stoul(graph.system(i).name.substr(1));
+  for (const Dispatch dispatch : {Dispatch::Graph, Dispatch::Serial, Dispatch::Auto})
+    for (int threads : {1, 2, 4}) {
+      for (uint64_t seed : {11u, 12u}) {
+        auto systems = test::random_systems(30, 8, seed);
+        RunLog log(systems.size());
+        // Registration index -> log slot; the graph reorders, so the run closure keeps its slot.
+        for (size_t k = 0; k < systems.size(); ++k) {
+          systems[k].run = [&log, k](const FrameContext& ctx) {
+            log.start[k] = ++log.ticket;
+            log.frame_seen[k] = ctx.frame;
+            std::this_thread::yield();  // widen the window in which a wrong order would show
+            ++log.runs[k];
+            log.end[k] = ++log.ticket;
+          };
+        }
+        const FrameGraph graph(systems);
+        std::vector<size_t> slot(graph.size());  // graph index -> registration index
+        for (size_t i = 0; i < graph.size(); ++i)
+          slot[i] = std::stoul(graph.system(i).name.substr(1));
 
-      Executor ex(graph, threads, AccessCheck::On);
-      ASSERT_TRUE(ex.checks_access());
-      EXPECT_EQ(ex.threads(), threads);
-      constexpr uint64_t kFrames = 15;
-      for (uint64_t f = 0; f < kFrames; ++f) {
-        ex.run_frame({f, f * 0.01, 0.01});
-        for (size_t i = 0; i < graph.size(); ++i) {
-          ASSERT_EQ(log.runs[slot[i]], f + 1) << graph.system(i).name;
-          ASSERT_EQ(log.frame_seen[slot[i]], f);
-          for (size_t j = 0; j < graph.size(); ++j) {
-            if (graph.reaches(i, j)) {
-              ASSERT_GT(log.start[slot[j]], log.end[slot[i]])
-                  << graph.system(j).name << " started before " << graph.system(i).name
-                  << " ended; threads " << threads << " seed " << seed;
+        Executor ex(graph, threads, {.access_check = AccessCheck::On, .dispatch = dispatch});
+        ASSERT_TRUE(ex.checks_access());
+        EXPECT_EQ(ex.threads(), threads);
+        constexpr uint64_t kFrames = 15;
+        for (uint64_t f = 0; f < kFrames; ++f) {
+          ex.run_frame({f, f * 0.01, 0.01});
+          for (size_t i = 0; i < graph.size(); ++i) {
+            ASSERT_EQ(log.runs[slot[i]], f + 1) << graph.system(i).name;
+            ASSERT_EQ(log.frame_seen[slot[i]], f);
+            for (size_t j = 0; j < graph.size(); ++j) {
+              if (graph.reaches(i, j)) {
+                ASSERT_GT(log.start[slot[j]], log.end[slot[i]])
+                    << graph.system(j).name << " started before " << graph.system(i).name
+                    << " ended; threads " << threads << " seed " << seed << " dispatch "
+                    << int(dispatch);
+              }
             }
           }
         }
       }
     }
-  }
 }
 
 TEST(Executor, IndependentSystemsRunConcurrently) {
-  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "needs 2 hardware threads";
+  PHACO_REQUIRE_ENVIRONMENT(std::thread::hardware_concurrency() >= 2, "needs 2 hardware threads");
   std::atomic<int> arrived{0};
   std::atomic<int> saw_other{0};
   // Each waits (bounded) for the other to start: both can only see it if they overlap in time.
@@ -93,6 +97,45 @@ TEST(Executor, IndependentSystemsRunConcurrently) {
   ex.run_frame({});
   EXPECT_EQ(arrived.load(), 2);
   EXPECT_EQ(saw_other.load(), 2) << "the two independent systems never overlapped";
+}
+
+// Auto hands a frame to the flow graph only while overlapping its branches is predicted to save
+// more than the dispatch costs: never for a graph of 20 us systems, always for two independent
+// 3 ms ones. The costs are measured, but far from the 0.05 ms line either way.
+void busy_for(std::chrono::microseconds d) {
+  const auto until = std::chrono::steady_clock::now() + d;
+  while (std::chrono::steady_clock::now() < until) {
+  }
+}
+
+TEST(Executor, AutoDispatchRunsSmallFramesSeriallyAndWideOnesThroughTheGraph) {
+  using std::chrono::microseconds;
+  auto tiny = [](const FrameContext&) { busy_for(microseconds(10)); };
+  const FrameGraph small({make_system("a", {}, {"x"}, tiny), make_system("b", {}, {"y"}, tiny),
+                          make_system("c", {"x", "y"}, {"z"}, tiny)});
+  Executor ex_small(small, 2);
+  for (int f = 0; f < 10; ++f) ex_small.run_frame({});
+  EXPECT_EQ(ex_small.graph_frames(), 1u) << "only the first frame, while costs are unknown";
+  EXPECT_EQ(ex_small.serial_frames(), 9u);
+
+  auto wide = [](const FrameContext&) { busy_for(microseconds(3000)); };
+  const FrameGraph both(
+      {make_system("left", {}, {"l"}, wide), make_system("right", {}, {"r"}, wide)});
+  Executor ex_wide(both, 2);
+  for (int f = 0; f < 5; ++f) ex_wide.run_frame({});
+  EXPECT_EQ(ex_wide.graph_frames(), 5u);
+  EXPECT_EQ(ex_wide.serial_frames(), 0u);
+
+  // One thread has nobody to overlap with; Graph and Serial are taken as asked.
+  Executor ex_one(both, 1);
+  ex_one.run_frame({}), ex_one.run_frame({});
+  EXPECT_EQ(ex_one.serial_frames(), 2u);
+  Executor ex_graph(small, 2, {.dispatch = Dispatch::Graph});
+  Executor ex_serial(both, 2, {.dispatch = Dispatch::Serial});
+  for (int f = 0; f < 3; ++f) ex_graph.run_frame({}), ex_serial.run_frame({});
+  EXPECT_EQ(ex_graph.graph_frames(), 3u);
+  EXPECT_EQ(ex_serial.serial_frames(), 3u);
+  EXPECT_THROW(Executor(small, 2, {.dispatch_cost_ms = std::nan("")}), std::invalid_argument);
 }
 
 TEST(Executor, RecordsOneTimingSamplePerFrame) {
@@ -124,6 +167,18 @@ TEST(Executor, PercentilesUseNearestRank) {
   EXPECT_EQ(t.percentile_ms(100), 100.0);
   EXPECT_EQ(t.percentile_ms(0), 1.0);
   EXPECT_EQ(t.percentile_ms(50.5), 51.0);
+}
+
+TEST(Executor, SystemExceptionReachesCallerAndExecutorRecoversOnASerialFrame) {
+  int calls = 0;
+  const FrameGraph graph({make_system("a", {}, {"x"}, [&](const FrameContext&) {
+    if (++calls == 2) throw std::runtime_error("boom");
+  })});
+  Executor ex(graph, 2, {.access_check = AccessCheck::On, .dispatch = Dispatch::Serial});
+  ex.run_frame({});
+  EXPECT_THROW(ex.run_frame({}), std::runtime_error);
+  ex.run_frame({});
+  EXPECT_EQ(calls, 3);
 }
 
 TEST(Executor, SystemExceptionReachesCallerAndExecutorRecovers) {
