@@ -14,6 +14,9 @@ build="$root/build/release"
 PHACO_BUILD_DIR="$build" "$root/scripts/build.sh"
 # Tests build their meshes into a cache inside the build tree, never into the user's home.
 export PHACO_CACHE_DIR="$build/mesh-cache"
+# A test that needs an X server, GL or xvfb-run fails here instead of skipping: this run must not
+# pass on a machine where the renderer and the trainer never ran (tests/support/environment.hpp).
+export PHACO_TEST_STRICT=1
 ctest --test-dir "$build" --output-on-failure -j "$jobs"
 # The perf harness's quick sweep (issue 9): every drill at levels 0..3 and each method alternative,
 # each point in its own process. It fails the run if a point does not run to its end, if 1 and 2

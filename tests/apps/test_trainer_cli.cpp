@@ -17,6 +17,7 @@
 #include "engine/io/scenario.hpp"
 #include "engine/io/track.hpp"
 #include "engine/render/renderer.hpp"
+#include "tests/support/environment.hpp"
 #include "tests/support/shell.hpp"
 
 namespace phaco {
@@ -147,7 +148,8 @@ class TrainerCli : public ::testing::Test {
 #if defined(__SANITIZE_ADDRESS__)
     GTEST_SKIP() << "whole drills in real time under ASan and llvmpipe; the Release pass runs them";
 #endif
-    if (!have_xvfb()) GTEST_SKIP() << "xvfb-run not found (scripts/install-deps.sh installs xvfb)";
+    PHACO_REQUIRE_ENVIRONMENT(have_xvfb(),
+                              "xvfb-run not found (scripts/install-deps.sh installs xvfb)");
   }
 };
 

@@ -16,6 +16,7 @@
 #include "engine/render/renderer.hpp"
 #include "procedures/eye/eye_geometry.hpp"
 #include "procedures/eye/eye_mesh.hpp"
+#include "tests/support/environment.hpp"
 
 namespace phaco::render {
 namespace {
@@ -125,9 +126,10 @@ class RendererTest : public ::testing::Test {
     glfwTerminate();
   }
   void SetUp() override {
-    if (!std::getenv("DISPLAY"))
-      GTEST_SKIP() << "no X display ($DISPLAY unset): run under xvfb-run";
-    if (!window_) GTEST_SKIP() << "no OpenGL 3.3 core context from GLFW on this display";
+    PHACO_REQUIRE_ENVIRONMENT(std::getenv("DISPLAY") != nullptr,
+                              "no X display ($DISPLAY unset): run under xvfb-run");
+    PHACO_REQUIRE_ENVIRONMENT(window_ != nullptr,
+                              "no OpenGL 3.3 core context from GLFW on this display");
     target_ = std::make_unique<OffscreenTarget>(kW, kH);
   }
 
