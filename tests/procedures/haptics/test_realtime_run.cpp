@@ -2,7 +2,9 @@
 // scripted device drives the forceps, every frame publishes a model, the thread adopts them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "engine/haptics/scripted_device.hpp"
 #include "procedures/haptics/realtime_run.hpp"
@@ -35,10 +37,13 @@ TEST(RealtimeRun, AScriptedDeviceDrivesTheSceneInRealTime) {
   EXPECT_GE(r.haptics.models_published, r.frames)
       << "one model per frame (and one before the start)";
   const HapticHandStats& h = r.haptics.hands[static_cast<size_t>(Hand::Left)];
+  // Counts, not rates (issue 18): the loop ran, read the device and took the scene's models. How
+  // fast it ticks beside the frames is the harness's figure (phaco-perf haptics).
   EXPECT_TRUE(h.attached);
-  EXPECT_GT(h.ticks, 100u);
-  EXPECT_GT(h.samples, 100u);
-  EXPECT_GT(h.models_adopted, 10u);
+  EXPECT_GT(h.ticks, 0u);
+  EXPECT_GT(h.samples, 0u);
+  EXPECT_GT(h.models_adopted, 0u);
+  EXPECT_LE(h.models_adopted, r.haptics.models_published);
   EXPECT_FALSE(r.haptics.hands[static_cast<size_t>(Hand::Right)].attached);
   const nlohmann::json j = to_json(r);
   EXPECT_TRUE(j["haptics"]["hands"].contains("left"));
@@ -55,14 +60,26 @@ TEST(RealtimeRun, AStalledSimulationLeavesTheHapticThreadRunning) {
   run.duration_s = 0.6;
   run.stall_at_s = 0.2;
   run.stall_ms = 200;
+  // The haptic ticks seen after each frame: the stall lies between two of them.
+  std::vector<uint64_t> ticks_after_frame;
+  ticks_after_frame.reserve(128);
+  run.after_frame = [&](Scene&) {
+    ticks_after_frame.push_back(session.stats().hands[static_cast<size_t>(Hand::Left)].ticks);
+  };
   const RealtimeRunReport r = run_realtime(s, o, session, run);
   const auto planned = static_cast<uint64_t>(std::ceil(0.6 / s.dt_s - 1e-9));
   EXPECT_EQ(r.frames, planned - 1) << "one frame slot spent stalled";
   EXPECT_GE(r.late_frames, 1u) << "the frames after the stall start late";
   const HapticHandStats& h = r.haptics.hands[static_cast<size_t>(Hand::Left)];
-  // 200 ms without a model: the haptic thread went on ticking and reading the device.
-  EXPECT_GT(h.ticks, 300u);
-  EXPECT_GT(h.samples, 300u);
+  // 200 ms without a model: the haptic thread went on ticking and reading the device, more ticks
+  // across the stalled slot than across any ordinary frame (8 ms), and the force never dropped.
+  ASSERT_GE(ticks_after_frame.size(), 3u);
+  std::vector<uint64_t> gaps;
+  for (size_t i = 1; i < ticks_after_frame.size(); ++i)
+    gaps.push_back(ticks_after_frame[i] - ticks_after_frame[i - 1]);
+  std::sort(gaps.begin(), gaps.end());
+  EXPECT_GT(gaps.back(), gaps[gaps.size() / 2]) << "no frame gap held more ticks than the median";
+  EXPECT_GT(h.samples, 0u);
   EXPECT_EQ(h.zero_force_ticks, 0u);
 }
 

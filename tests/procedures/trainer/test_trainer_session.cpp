@@ -1,7 +1,12 @@
 // The trainer session (procedures/trainer/trainer_session): start, pause, resume, reset and
 // finish with scripted devices on the capsulorhexis expert; the stored recording replays to the
-// stored state hash (headless) and replay_last() reaches it live; a renderer that sleeps 200 ms
-// per snapshot slows neither the simulation nor the haptic loop.
+// stored state hash (headless) and replay_last() reaches it live; a renderer that holds a snapshot
+// holds up neither the simulation nor the haptic loop.
+//
+// No test here asserts a wall-clock rate (issue 18): each waits, with a generous bound that only
+// guards against a hang, for counters to reach a value, and checks what must hold when they do.
+// How fast the simulation and the haptic loop run beside the renderer is measured by
+// `phaco-perf trainer` (perf/RESULTS.md).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -39,6 +44,18 @@ void wait_for(TrainerSession& s, TrainerState state, std::chrono::milliseconds l
     std::this_thread::sleep_for(10ms);
 }
 
+// Polls until `reached(status)` holds; false if it has not after `limit` (a hang guard, not a
+// rate: on any machine that runs the session at all, the counters get there well before).
+template <class Pred>
+bool wait_until(const TrainerSession& s, Pred reached, std::chrono::seconds limit = 30s) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!reached(s.status())) {
+    if (std::chrono::steady_clock::now() >= until) return false;
+    std::this_thread::sleep_for(2ms);
+  }
+  return true;
+}
+
 TEST(TrainerSession, StartPauseResumeResetFinish) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "real-time drills run in the Release pass";
@@ -53,15 +70,20 @@ TEST(TrainerSession, StartPauseResumeResetFinish) {
   EXPECT_EQ(snap->bodies.size(), 4u);
   EXPECT_EQ(snap->tools.size(), 2u);
 
-  std::this_thread::sleep_for(200ms);
+  ASSERT_TRUE(wait_until(s, [](const TrainerStatus& st) { return st.frame > 1; }));
   s.pause();
   EXPECT_EQ(s.state(), TrainerState::Paused);
-  std::this_thread::sleep_for(50ms);  // the frame in progress, if any, ends
+  // The simulation checks for a pause before each frame, so at most the frame in progress when
+  // pause() returned still ends; the haptic loop runs on meanwhile.
+  const TrainerStatus at_pause = s.status();
+  ASSERT_TRUE(wait_until(s, [&](const TrainerStatus& st) {
+    return st.haptic_ticks >= at_pause.haptic_ticks + 200;
+  })) << "the haptic loop runs on while paused";
   const uint64_t paused_frame = s.status().frame;
-  EXPECT_GT(paused_frame, 1u);
-  std::this_thread::sleep_for(200ms);
+  EXPECT_LE(paused_frame, at_pause.frame + 1) << "only the frame in progress ends";
+  ASSERT_TRUE(wait_until(
+      s, [&](const TrainerStatus& st) { return st.haptic_ticks >= at_pause.haptic_ticks + 400; }));
   EXPECT_EQ(s.status().frame, paused_frame) << "no frames while paused";
-  EXPECT_GT(s.status().haptic_ticks, 100) << "the haptic loop runs on while paused";
   s.resume();
   wait_for(s, TrainerState::Ended, 5s);
   EXPECT_EQ(s.state(), TrainerState::Ended);
@@ -118,40 +140,34 @@ TEST(TrainerSession, TheRecordedRunReplaysToTheSameHash) {
   std::filesystem::remove(db);
 }
 
-TEST(TrainerSession, ASlowRendererSlowsNeitherSimulationNorHaptics) {
+TEST(TrainerSession, ARendererHoldingASnapshotHoldsUpNeitherSimulationNorHaptics) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "rates are measured in the Release pass";
+  GTEST_SKIP() << "a 3 s real-time drill; the Release pass runs it";
 #endif
   TrainerSession s(config(3.0));
   s.start();
-  std::atomic<bool> done{false};
-  std::atomic<int> reads{0};
-  std::thread renderer([&] {
-    while (!done.load()) {
-      if (s.newest_snapshot()) reads.fetch_add(1);
-      std::this_thread::sleep_for(200ms);  // a very slow renderer
-    }
-  });
+  // The render thread takes the newest snapshot and keeps drawing from it, as a renderer far
+  // slower than the simulation would, for as long as the counters below take to move.
+  const render::RenderSnapshot* held = s.newest_snapshot();
+  ASSERT_NE(held, nullptr);
+  const uint64_t held_frame = held->frame;
+  const size_t held_bodies = held->bodies.size();
   const TrainerStatus a = s.status();
-  const auto t0 = std::chrono::steady_clock::now();
-  std::this_thread::sleep_for(1s);
+  const bool moved = wait_until(s, [&](const TrainerStatus& st) {
+    return st.frame >= a.frame + 120 && st.haptic_ticks >= a.haptic_ticks + 500 &&
+           st.snapshots_published >= a.snapshots_published + 60;
+  });
   const TrainerStatus b = s.status();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  done.store(true);
-  renderer.join();
+  EXPECT_TRUE(moved) << "while the snapshot was held: " << (b.frame - a.frame) << " frames, "
+                     << (b.haptic_ticks - a.haptic_ticks) << " haptic ticks, "
+                     << (b.snapshots_published - a.snapshots_published) << " snapshots published";
+  // The held snapshot was never written under the reader, and the next take is a newer one.
+  EXPECT_EQ(held->frame, held_frame);
+  EXPECT_EQ(held->bodies.size(), held_bodies);
+  const render::RenderSnapshot* next = s.newest_snapshot();
+  ASSERT_NE(next, nullptr);
+  EXPECT_GT(next->frame, held_frame);
   s.stop();
-  const double dt = config(3.0).scenario.dt_s;
-  std::printf(
-      "slow renderer: %llu frames, %lld haptic ticks over %.3f s wall; %d reads, %llu "
-      "snapshots published\n",
-      static_cast<unsigned long long>(b.frame - a.frame),
-      static_cast<long long>(b.haptic_ticks - a.haptic_ticks), wall, reads.load(),
-      static_cast<unsigned long long>(b.snapshots_published - a.snapshots_published));
-  EXPECT_GE(static_cast<double>(b.frame - a.frame), 0.8 * wall / dt)
-      << "frames simulated over " << wall << " s";
-  EXPECT_GE(static_cast<double>(b.haptic_ticks - a.haptic_ticks), 0.7 * wall * 1000);
-  EXPECT_GT(b.snapshots_published - a.snapshots_published, 50u * reads.load() / 10);
-  EXPECT_GE(reads.load(), 4);
 }
 
 TEST(TrainerSession, BadDeviceSpecsAndFinishBeforeStartAreInputErrors) {
