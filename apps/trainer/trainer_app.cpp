@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <deque>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "apps/trainer/trainer_ui.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
+#include "engine/records/record_run.hpp"
 #include "engine/render/offscreen.hpp"
 #include "engine/render/renderer.hpp"
 #include "procedures/scene/scene.hpp"
@@ -236,7 +238,9 @@ int run_trainer(const TrainerOptions& o) {
         if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back()) ==
             UiAction::Restart) {
           config = ui.config();
-          session = std::make_unique<TrainerSession>(config);
+          auto next = std::make_unique<TrainerSession>(config);
+          next->take_unsaved_from(*session);  // drills the database refused stay kept
+          session = std::move(next);
           session->start();
         }
         ImGui::Render();
@@ -259,6 +263,34 @@ int run_trainer(const TrainerOptions& o) {
       }
     }
     session->stop();
+    if (session->unsaved_count() > 0) {
+      // Closing with drills the database refused: never lose them silently. Beside the
+      // database first; where that folder is the problem (read-only, full), the temp folder.
+      std::vector<std::filesystem::path> dirs;
+      try {
+        dirs.push_back(
+            (config.records_db.empty() ? default_records_db() : config.records_db).parent_path() /
+            "unsaved");
+      } catch (const InputError&) {
+      }
+      dirs.push_back(std::filesystem::temp_directory_path() / "openphaco-unsaved");
+      std::string why;
+      bool kept = false;
+      for (const auto& dir : dirs) {
+        try {
+          for (const auto& f : session->write_unsaved(dir))
+            std::fprintf(stderr, "phaco-trainer: an unsaved drill is kept in %s\n", f.c_str());
+          kept = true;
+          break;
+        } catch (const InputError& e) {
+          why += std::string(why.empty() ? "" : "; ") + e.what();
+        }
+      }
+      if (!kept) {
+        std::fprintf(stderr, "phaco-trainer: unsaved drills could not be kept: %s\n", why.c_str());
+        exit_code = exit_code == 0 ? 2 : exit_code;
+      }
+    }
   }
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();

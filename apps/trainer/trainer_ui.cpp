@@ -74,8 +74,12 @@ void TrainerUi::finish(TrainerSession& session) {
   finished_ = true;  // once, also when it fails: the message says why
   try {
     report_ = session.finish();
-    message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
-                                             : std::string("finished (not stored: no trainee)");
+    if (report_.contains("save_error"))
+      message_ = "NOT STORED: " + report_["save_error"].get<std::string>() +
+                 ". The drill is kept: fix the cause and press 'Save again'.";
+    else
+      message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
+                                               : std::string("finished (not stored: no trainee)");
   } catch (const InputError& e) {
     message_ = e.what();
   }
@@ -176,11 +180,26 @@ void TrainerUi::live_panel(TrainerSession& session, double frame_ms) {
   ImGui::End();
 }
 
-void TrainerUi::result_panel(TrainerSession&) {
+void TrainerUi::result_panel(TrainerSession& session) {
   if (!finished_ || !report_.is_object()) return;
   ImGui::SetNextWindowPos(ImVec2(options_.width - 390.0f, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("Result");
+  // Drills whose record the database refused stay in memory until they are stored.
+  if (session.unsaved_count() > 0) {
+    ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.3f, 1.0f), "%zu finished drill(s) not stored",
+                       session.unsaved_count());
+    if (ImGui::Button("Save again")) {
+      try {
+        const std::vector<int64_t> ids = session.save_unsaved();
+        report_ = session.last_report();
+        message_ = "stored " + std::to_string(ids.size()) + " drill(s), last as record " +
+                   std::to_string(ids.back());
+      } catch (const InputError& e) {
+        message_ = std::string("still not stored: ") + e.what();
+      }
+    }
+  }
   const auto& m = report_.value("metrics", nlohmann::json::object());
   ImGui::Text("score %.1f / 100", m.value("score", 0.0));
   if (ImGui::BeginTable("terms", 4, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {

@@ -61,17 +61,22 @@ void check_record_target(const fs::path& db, const std::string& trainee) {
   const RecordStore store(db, OpenMode::CreateIfMissing);
 }
 
+double unix_now_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
 int64_t record_run(const fs::path& db, const std::string& trainee, const Scenario& scenario,
-                   const json& report, std::optional<double> run_s) {
+                   const json& report, std::optional<double> run_s,
+                   std::optional<double> finished_unix_s) {
   check_trainee(trainee);
   SessionRecord r;
   r.trainee = trainee;
   r.drill = std::string(to_string(scenario.drill));
   r.scenario_name =
       scenario.name.empty() ? fs::path(scenario.source).stem().string() : scenario.name;
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  const double now = static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+  const double now = finished_unix_s.value_or(unix_now_s());
   r.started_utc = format_utc(now - run_seconds(report, run_s));
   r.finished_utc = format_utc(now);
   r.recording = to_json(scenario);

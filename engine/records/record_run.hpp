@@ -28,10 +28,16 @@ void check_record_target(const std::filesystem::path& db, const std::string& tra
 // Stores a finished run: `scenario` is what replays it (its JSON becomes the recording),
 // `report` the run report (to_json of RunReport, with "metrics" and "state_hash"). The run
 // started `run_s` wall seconds before now; without it, the report's wall_time_s + mesh_load_s
-// (a headless run's own clock). Creates the database and its directory when missing. Returns the
-// new record's id; throws InputError naming the file.
+// (a headless run's own clock). `finished_unix_s`: when the run ended (s since the Unix epoch),
+// for a record stored later than that (the trainer's "save again"); default now. Creates the
+// database and its directory when missing. Returns the new record's id; throws InputError naming
+// the file.
 int64_t record_run(const std::filesystem::path& db, const std::string& trainee,
                    const Scenario& scenario, const nlohmann::json& report,
-                   std::optional<double> run_s = std::nullopt);
+                   std::optional<double> run_s = std::nullopt,
+                   std::optional<double> finished_unix_s = std::nullopt);
+
+// Seconds since the Unix epoch now (the realtime clock), as record_run reads it.
+double unix_now_s();
 
 }  // namespace phaco

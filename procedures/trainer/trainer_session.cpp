@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <future>
 
 #include "engine/core/clock.hpp"
@@ -259,13 +260,72 @@ nlohmann::json TrainerSession::finish() {
     const std::filesystem::path db =
         config_.records_db.empty() ? default_records_db() : config_.records_db;
     // The drill took the live run's wall time (pauses left out), not the replay's.
-    j["record_id"] = record_run(db, config_.trainee, recorded, j, j["live"].value("wall_s", 0.0));
+    const double run_s = j["live"].value("wall_s", 0.0);
+    const double finished_s = unix_now_s();
+    for (UnsavedRun& u : unsaved_) u.is_last = false;
+    try {
+      j["record_id"] = record_run(db, config_.trainee, recorded, j, run_s, finished_s);
+    } catch (const InputError& e) {
+      // The database failed at the worst moment, after the drill: keep the drill, say why, and
+      // let the trainee save it again (save_unsaved) once the cause is fixed.
+      unsaved_.push_back({db, config_.trainee, recorded, j, run_s, finished_s, true});
+      j["save_error"] = e.what();
+    }
     report = std::move(j);
   } else {
     report["recorded_from"] = from;
   }
   last_report_ = report;
   return report;
+}
+
+std::vector<int64_t> TrainerSession::save_unsaved() {
+  std::vector<int64_t> ids;
+  while (!unsaved_.empty()) {
+    UnsavedRun& u = unsaved_.front();
+    const int64_t id = record_run(u.db, u.trainee, u.recording, u.report, u.run_s, u.finished_s);
+    ids.push_back(id);
+    if (u.is_last) {
+      last_report_.erase("save_error");
+      last_report_["record_id"] = id;
+    }
+    unsaved_.erase(unsaved_.begin());
+  }
+  return ids;
+}
+
+void TrainerSession::take_unsaved_from(TrainerSession& other) {
+  if (&other == this) return;
+  for (UnsavedRun& u : other.unsaved_) {
+    u.is_last = false;
+    unsaved_.push_back(std::move(u));
+  }
+  other.unsaved_.clear();
+}
+
+std::vector<std::filesystem::path> TrainerSession::write_unsaved(
+    const std::filesystem::path& dir) const {
+  std::vector<std::filesystem::path> files;
+  if (unsaved_.empty()) return files;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string() + ": cannot create the folder: " + ec.message());
+  for (const UnsavedRun& u : unsaved_) {
+    // The finishing time in the name keeps files from different drills and sessions apart.
+    std::string stamp = format_utc(u.finished_s);
+    std::replace(stamp.begin(), stamp.end(), ':', '-');
+    const std::filesystem::path file =
+        dir / (std::string(to_string(u.recording.drill)) + "-" + stamp + ".json");
+    nlohmann::json j = to_json(u.recording);
+    j["description"] = "Unsaved trainer drill of '" + u.trainee + "' (the records database " +
+                       u.db.string() + " refused it); store it with: phaco run FILE --record " +
+                       u.db.string() + " --trainee NAME";
+    std::ofstream out(file, std::ios::binary);
+    out << j.dump(2) << "\n";
+    if (!out) throw InputError(file.string() + ": cannot write the unsaved drill");
+    files.push_back(file);
+  }
+  return files;
 }
 
 void TrainerSession::replay_last() {

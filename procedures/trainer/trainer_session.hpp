@@ -129,6 +129,23 @@ class TrainerSession {
   // The last finish()'s report.
   const nlohmann::json& last_report() const { return last_report_; }
 
+  // Finished drills whose record could not be written (the database full, locked, read-only or
+  // damaged: finish() then returns the report with "save_error" naming the database instead of
+  // "record_id"). They are kept in memory, oldest first, until saved; nothing is dropped.
+  size_t unsaved_count() const { return unsaved_.size(); }
+  // Stores the unsaved drills again, oldest first, each with the time it really finished; returns
+  // the new record ids. Throws InputError naming the database at the first that fails still:
+  // those stored before it stay stored, the rest stay kept. The last report gains "record_id"
+  // when its drill is stored.
+  std::vector<int64_t> save_unsaved();
+  // Moves `other`'s unsaved drills to the end of this session's (a new session for a new drill
+  // keeps what the old one could not store).
+  void take_unsaved_from(TrainerSession& other);
+  // The last resort when the trainer closes with drills unsaved: each one's recording as a
+  // scenario file in `dir` (created), which `phaco run FILE --record DB --trainee NAME` stores
+  // later. Returns the files written; throws InputError naming a file it cannot write.
+  std::vector<std::filesystem::path> write_unsaved(const std::filesystem::path& dir) const;
+
  private:
   void launch(const Scenario& scenario, const std::array<std::string, 2>& devices);
   void join();
@@ -170,6 +187,17 @@ class TrainerSession {
 
   std::optional<Scenario> last_recording_;
   nlohmann::json last_report_;
+
+  struct UnsavedRun {
+    std::filesystem::path db;
+    std::string trainee;
+    Scenario recording;
+    nlohmann::json report;  // the stored report: the replay's, with the live figures
+    double run_s = 0;       // the live run's wall time, pauses left out
+    double finished_s = 0;  // when it ended, s since the Unix epoch
+    bool is_last = false;   // the drill last_report_ describes
+  };
+  std::vector<UnsavedRun> unsaved_;  // UI thread
 };
 
 }  // namespace phaco

@@ -3,12 +3,15 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sqlite3.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <thread>
 
@@ -300,6 +303,153 @@ TEST(Records, WriterKilledMidStreamLeavesCommittedRecordsIntact) {
   EXPECT_GE(ben.size(), static_cast<size_t>(committed));
   for (const auto& r : ben) EXPECT_EQ(r.report["padding"].get<std::string>().size(), 256u * 1024u);
   EXPECT_GT(store.add_record(sample("ana", "2026-11-23T09:00:00.000Z", 43)), 0);
+}
+
+// Runs `body` in a forked child and returns what it reports through a pipe (at most 4 kB): the
+// fault tests change process-wide limits (file size, user id) that the test runner must keep.
+std::string in_child(const std::function<std::string()>& body) {
+  int fds[2];
+  if (pipe(fds) != 0) return "pipe failed";
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    std::string out;
+    try {
+      out = body();
+    } catch (const std::exception& e) {
+      out = std::string("unexpected exception: ") + e.what();
+    }
+    const ssize_t w = write(fds[1], out.data(), std::min<size_t>(out.size(), 4096));
+    _exit(w < 0 ? 4 : 0);
+  }
+  close(fds[1]);
+  std::string got;
+  char buf[4096];
+  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) got.append(buf, static_cast<size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  if (!WIFEXITED(status)) return "child died: signal " + std::to_string(WTERMSIG(status));
+  return got;
+}
+
+// Issue 18 item 6: a full disk. The child may grow no file past the size the database has now
+// (RLIMIT_FSIZE; SIGXFSZ ignored, so the write fails with EFBIG as on a full file system) and
+// adds big records until one fails: the error names the database, and every record stored
+// before it is intact afterwards.
+TEST(Records, AFullDiskNamesTheDatabaseAndKeepsEveryEarlierRecord) {
+  const TempDb tmp("full");
+  const fs::path& file = tmp.file;
+  RecordStore(file).add_record(sample("ana", "2026-11-21T09:00:00.000Z", 42));
+  const std::string child = in_child([&] {
+    signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{static_cast<rlim_t>(fs::file_size(file) + 64 * 1024),
+                       static_cast<rlim_t>(fs::file_size(file) + 64 * 1024)};
+    if (setrlimit(RLIMIT_FSIZE, &limit) != 0) return std::string("setrlimit failed");
+    RecordStore store(file);
+    SessionRecord r = sample("ben", "2026-11-22T09:00:00.000Z", 1);
+    r.report["padding"] = std::string(40 * 1024, 'p');
+    int stored = 0;
+    try {
+      for (; stored < 1000; ++stored) store.add_record(r);
+    } catch (const InputError& e) {
+      return "stored " + std::to_string(stored) + ": " + e.what();
+    }
+    return std::string("never failed");
+  });
+  ASSERT_EQ(child.rfind("stored ", 0), 0u) << child;
+  EXPECT_NE(child.find(file.string()), std::string::npos) << child;
+  EXPECT_TRUE(child.find("full") != std::string::npos ||
+              child.find("disk I/O") != std::string::npos)
+      << child;
+  const int stored_before_full = std::stoi(child.substr(7));
+  RecordStore store(file);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  ASSERT_EQ(store.records_of("ana").size(), 1u);
+  EXPECT_EQ(*store.records_of("ana")[0].score, 42);
+  EXPECT_EQ(store.records_of("ben").size(), static_cast<size_t>(stored_before_full));
+  // With room again the same file takes the next record.
+  EXPECT_GT(store.add_record(sample("ana", "2026-11-23T09:00:00.000Z", 43)), 0);
+}
+
+// A database the user may read but not write (another user's file, a read-only share): the
+// child drops to the unprivileged user `nobody` (root ignores file modes), opens the file,
+// reads it, and its write fails naming the database.
+TEST(Records, AReadOnlyDatabaseNamesTheDatabaseAndKeepsItsRecords) {
+  const TempDb tmp("readonly");
+  const fs::path& file = tmp.file;
+  RecordStore(file).add_record(sample("ana", "2026-11-21T09:00:00.000Z", 42));
+  fs::permissions(file.parent_path(), fs::perms::owner_all | fs::perms::group_read |
+                                          fs::perms::group_exec | fs::perms::others_read |
+                                          fs::perms::others_exec);
+  for (const char* suffix : {"", "-wal", "-shm"}) {
+    const fs::path f = file.string() + suffix;
+    if (fs::exists(f))
+      fs::permissions(f, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read |
+                             fs::perms::others_read);
+  }
+  const std::string child = in_child([&] {
+    if (geteuid() == 0 && setuid(65534) != 0) return std::string("setuid failed");
+    try {
+      RecordStore store(file);
+      const size_t before = store.records_of("ana").size();
+      store.add_record(sample("ben", "2026-11-22T09:00:00.000Z", 1));
+      return "wrote (read " + std::to_string(before) + ")";
+    } catch (const InputError& e) {
+      return std::string("error: ") + e.what();
+    }
+  });
+  ASSERT_EQ(child.rfind("error: ", 0), 0u) << child;
+  EXPECT_NE(child.find(file.string()), std::string::npos) << child;
+  EXPECT_TRUE(child.find("read-only") != std::string::npos ||
+              child.find("cannot open") != std::string::npos ||
+              child.find("unable to open") != std::string::npos)
+      << child;
+  const RecordStore store(file, OpenMode::ExistingOnly);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  EXPECT_EQ(store.records_of("ana").size(), 1u);
+  EXPECT_TRUE(store.records_of("ben").empty());
+}
+
+// A file damaged on disk (bytes overwritten inside the records' pages): every call either works
+// or throws an InputError that names the file; none crashes.
+TEST(Records, ACorruptDatabaseNamesTheFileAndNeverCrashes) {
+  const TempDb tmp("corrupt");
+  const fs::path& file = tmp.file;
+  {
+    RecordStore store(file);
+    SessionRecord r = sample("ana", "2026-11-21T09:00:00.000Z", 42);
+    r.report["padding"] = std::string(20 * 1024, 'p');
+    for (int i = 0; i < 10; ++i) store.add_record(r);
+  }
+  raw_sql(file, "PRAGMA wal_checkpoint(TRUNCATE)");
+  const auto size = fs::file_size(file);
+  ASSERT_GT(size, 8u * 4096u);
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    for (std::streamoff at = 4096; at < static_cast<std::streamoff>(size); at += 4096 * 3) {
+      f.seekp(at);  // the page's header and cell pointers, and the start of its cells
+      const std::string junk(300, '\xA5');
+      f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+    }
+  }
+  int errors = 0;
+  auto attempt = [&](const std::function<void()>& call) {
+    try {
+      call();
+    } catch (const InputError& e) {
+      ++errors;
+      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    }
+  };
+  attempt([&] {
+    RecordStore store(file);
+    attempt([&] { (void)store.records_of("ana"); });
+    attempt([&] { (void)store.trainees(); });
+    attempt([&] { (void)store.integrity_check(); });
+    attempt([&] { store.add_record(sample("ben", "2026-11-22T09:00:00.000Z", 1)); });
+  });
+  EXPECT_GT(errors, 0) << "the damage went unnoticed";
 }
 
 TEST(Records, MetricUnitsComeFromTheNames) {

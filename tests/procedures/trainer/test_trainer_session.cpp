@@ -140,6 +140,65 @@ TEST(TrainerSession, TheRecordedRunReplaysToTheSameHash) {
   std::filesystem::remove(db);
 }
 
+// Issue 18 item 6: the database fails after the drill (here its file was replaced by a folder
+// while the trainee worked). The drill is not lost: finish() says why, naming the database, the
+// session keeps the drill, and once the cause is gone save_unsaved() stores it, with the state
+// hash it had; write_unsaved() is the trainer's last resort when it closes.
+TEST(TrainerSession, ADatabaseThatFailsAfterTheDrillLosesNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "real-time drills run in the Release pass";
+#endif
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("trainer-unsaved-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const auto db = dir / "records.sqlite";
+  TrainerConfig c = config(0.5);
+  c.trainee = "trainee two";
+  c.records_db = db;
+  TrainerSession s(c);
+  s.start();  // checks the database: it opens (and is created)
+  wait_for(s, TrainerState::Ended, 10s);
+  std::filesystem::remove(db);
+  std::filesystem::create_directories(db);  // the database cannot be opened any more
+  const nlohmann::json r = s.finish();
+  ASSERT_TRUE(r.contains("save_error")) << r.dump().substr(0, 300);
+  EXPECT_FALSE(r.contains("record_id"));
+  EXPECT_NE(r["save_error"].get<std::string>().find(db.string()), std::string::npos)
+      << r["save_error"];
+  EXPECT_EQ(s.unsaved_count(), 1u);
+  const std::string hash = r["state_hash"];
+
+  // Still failing: the error names the database and the drill stays kept.
+  EXPECT_THROW(s.save_unsaved(), InputError);
+  EXPECT_EQ(s.unsaved_count(), 1u);
+
+  // The last resort writes a scenario that replays the drill to the same hash.
+  const auto files = s.write_unsaved(dir / "unsaved");
+  ASSERT_EQ(files.size(), 1u);
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  EXPECT_EQ(run_scenario(load_scenario(files[0]), o).state_hash, hash);
+
+  // The cause gone, the drill is stored once, as it was.
+  std::filesystem::remove(db);
+  const std::vector<int64_t> ids = s.save_unsaved();
+  ASSERT_EQ(ids.size(), 1u);
+  EXPECT_EQ(s.unsaved_count(), 0u);
+  EXPECT_EQ(s.last_report()["record_id"], ids[0]);
+  EXPECT_FALSE(s.last_report().contains("save_error"));
+  const RecordStore store(db, OpenMode::ExistingOnly);
+  const auto rec = store.record(ids[0]);
+  ASSERT_TRUE(rec.has_value());
+  EXPECT_EQ(rec->state_hash, hash);
+  EXPECT_EQ(rec->trainee, "trainee two");
+  EXPECT_EQ(store.records_of("trainee two").size(), 1u);
+  // A new session for the next drill carries nothing over when nothing is unsaved.
+  TrainerSession next(c);
+  next.take_unsaved_from(s);
+  EXPECT_EQ(next.unsaved_count(), 0u);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(TrainerSession, ARendererHoldingASnapshotHoldsUpNeitherSimulationNorHaptics) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "a 3 s real-time drill; the Release pass runs it";
