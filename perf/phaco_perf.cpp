@@ -12,6 +12,7 @@
 //   phaco-perf tear         issue 17: forceps force on the capsulorhexis flap against time, bands
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
 //   phaco-perf sweep        issue 9: every drill at every level, thread count and method
+//   phaco-perf soak         issue 18: the trainer drill after drill; memory, GL objects, haptics
 //   alternative,
 //                           with the haptic thread beside it; the targets; the checks CI runs
 //   phaco-perf all          every study above, in that order
@@ -112,8 +113,17 @@ studies:
       --reference-dt-divisor change every chosen drill's recipe. About 5 minutes on an idle
       machine (11 under load). docs/perf_sweep.md says why the whole capsule
       (capsule.active_set=off) is not in it.
+  soak [--seconds S]
+      Issue 18, phaco-trainer left running drill after drill under Xvfb (phaco-trainer --soak):
+      the three drills in turn, scripted hands, 6 simulated s each, for S wall seconds (default
+      1800; quick 90). After each drill: resident memory, GL objects alive (probed with glIs*),
+      haptic period p99/max. Checks (exit status 1): at least three rounds of the three drills,
+      memory after the first round within 5 % of the first round's largest, and each drill
+      leaving as many GL objects alive every time it runs from the second round on. Charts
+      memory, GL objects and the haptic period against wall time. Needs xvfb-run.
   all
-      foundation, bandwidth, membrane, cut, lens, haptics, drills, tear, trainer, sweep.
+      foundation, bandwidth, membrane, cut, lens, haptics, drills, tear, trainer, sweep (not
+      soak: it takes half an hour on its own).
 
 Each study writes DIR/results/<study>.csv, .json, .md and <study>_*.png, then regenerates
 DIR/RESULTS.md (DIR defaults to the source tree's perf/).
@@ -166,6 +176,8 @@ int main(int argc, char** argv) {
       perf::run_trainer_study(options);
     } else if (cmd == "sweep") {
       perf::run_sweep(options);
+    } else if (cmd == "soak") {
+      perf::run_soak(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");

@@ -25,6 +25,7 @@ void run_drills(const StudyOptions& options);
 void run_tear(const StudyOptions& options);
 void run_trainer_study(const StudyOptions& options);
 void run_sweep(const StudyOptions& options);
+void run_soak(const StudyOptions& options);
 
 // A study's own checks failed (e.g. the sweep's accuracy bounds): the figures are still written,
 // and phaco-perf exits 1 naming what failed.

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/trainer/trainer_soak.hpp"
 #include "apps/trainer/trainer_ui.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
@@ -142,7 +143,7 @@ int run_trainer(const TrainerOptions& o) {
   if (!window) throw render::RenderError("cannot create an OpenGL 3.3 core window");
   glfwMakeContextCurrent(window);
   // Unattended runs measure and capture as fast as the renderer goes; a trainee gets v-sync.
-  glfwSwapInterval(o.screenshot || o.stats ? 0 : 1);
+  glfwSwapInterval(o.screenshot || o.stats || o.soak ? 0 : 1);
   InputGlue glue;
   glfwSetWindowUserPointer(window, &glue);
   glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) { glue_of(w)->wheel += dy; });
@@ -166,8 +167,56 @@ int run_trainer(const TrainerOptions& o) {
     const int64_t t0 = now_ns();
     const auto wall_s = [&] { return static_cast<double>(now_ns() - t0) * 1e-9; };
 
+    // --soak: the drill in progress, where its render frames start, and the samples so far.
+    std::string soak_drill(to_string(config.scenario.drill));
+    size_t soak_frame0 = 0;
+    std::vector<SoakSample> soak_samples;
+
     while (!glfwWindowShouldClose(window)) {
       glfwPollEvents();
+      // The Result panel finishes a drill that ended (Idle after), unless this loop got there
+      // first (Ended): either way the drill is over.
+      if (const TrainerState st = session->state();
+          o.soak && (st == TrainerState::Ended || st == TrainerState::Idle)) {
+        // A drill ended: sample, then the next drill in a new session, as a station runs.
+        const nlohmann::json r =
+            st == TrainerState::Ended ? session->finish() : session->last_report();
+        SoakSample s;
+        s.drill_index = static_cast<int>(soak_samples.size());
+        s.drill = soak_drill;
+        s.wall_s = wall_s();
+        s.rss_mb = resident_mb();
+        count_gl_objects(s);
+        const nlohmann::json period = r.contains("live")
+                                          ? r["live"]["haptics"].value("period", nlohmann::json())
+                                          : nlohmann::json();
+        s.haptic_period_p99_us = period.is_object() ? period.value("p99_us", 0.0) : 0.0;
+        s.haptic_period_max_us = period.is_object() ? period.value("max_us", 0.0) : 0.0;
+        FrameClock drill_frames;
+        drill_frames.ms.assign(frames.ms.begin() + static_cast<std::ptrdiff_t>(soak_frame0),
+                               frames.ms.end());
+        s.render_frame_p99_ms = drill_frames.percentile(0.99);
+        s.score = r.value("metrics", nlohmann::json::object()).value("score", 0.0);
+        soak_samples.push_back(s);
+        std::printf("soak: drill %d (%s) done at %.0f s: %.1f MiB, %d buffers, %d textures\n",
+                    s.drill_index, s.drill.c_str(), s.wall_s, s.rss_mb, s.gl_buffers,
+                    s.gl_textures);
+        std::fflush(stdout);
+        if (wall_s() >= o.soak_for_s) {
+          write_soak(*o.soak, soak_samples, o.soak_for_s);
+          std::printf("soak: %zu drills in %.0f s: %s\n", soak_samples.size(), wall_s(),
+                      o.soak->c_str());
+          break;
+        }
+        soak_drill = next_soak_drill(soak_drill);
+        config.scenario = load_scenario(drill_scenario(soak_drill));
+        auto next = std::make_unique<TrainerSession>(config);
+        next->take_unsaved_from(*session);
+        session = std::move(next);
+        session->start();
+        soak_frame0 = frames.ms.size();
+        continue;
+      }
       if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
       const bool ui_has_mouse = o.ui && ImGui::GetIO().WantCaptureMouse;
       const bool ui_has_keys = o.ui && ImGui::GetIO().WantCaptureKeyboard;
@@ -254,10 +303,13 @@ int run_trainer(const TrainerOptions& o) {
         std::printf("statistics after %.1f s: %s\n", wall_s(), o.stats->c_str());
         break;
       }
-      if ((o.screenshot || o.stats) && wall_s() > o.timeout_s) {
+      if ((o.screenshot || o.stats || o.soak) && wall_s() > o.timeout_s) {
         std::fprintf(stderr,
                      "phaco-trainer: timed out after %.0f s wall (simulated %.2f s of %.2f s)\n",
-                     wall_s(), status.sim_time_s, o.screenshot ? o.after_s : o.stats_after_s);
+                     wall_s(), status.sim_time_s,
+                     o.screenshot ? o.after_s
+                     : o.soak     ? o.soak_for_s
+                                  : o.stats_after_s);
         exit_code = 3;
         break;
       }

@@ -19,6 +19,7 @@ usage:
                 [--duration S] [--threads N] [--cache-dir DIR]
   phaco-trainer ... --screenshot OUT.png [--after SECONDS] [--no-ui]
   phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
+  phaco-trainer ... --soak OUT.json [--soak-for SECONDS]
   phaco-trainer --help
 
   --drill       corneal_incision | capsulorhexis | phaco_sculpting (default capsulorhexis); the
@@ -35,6 +36,10 @@ usage:
   --stats       run unattended: after --stats-after wall seconds (default 20) write the render
                 frame rate, the simulation rate and the haptic period as JSON, exit
   --no-render   with --stats: keep the window and the loop but draw nothing (the baseline)
+  --soak        run unattended drill after drill (the three drills in turn from the one given,
+                scripted hands unless --left/--right say otherwise) for --soak-for wall seconds
+                (default 60), then write per-drill resident memory, live GL objects and the
+                haptic period as JSON, exit (phaco-perf soak charts and checks it)
 
 controls: mouse moves the selected hand's tip, wheel = depth, left button = grip / ultrasound,
 right button = aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers =
@@ -74,7 +79,7 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
       "command line", raw,
       {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee", "--db", "--size",
        "--threads", "--cache-dir", "--screenshot", "--after", "--stats", "--stats-after",
-       "--duration", "--timeout"},
+       "--duration", "--timeout", "--soak", "--soak-for"},
       {"--stereo", "--no-guidance", "--no-ui", "--no-render"}, "phaco-trainer --help");
   if (!a.positional.empty()) {
     throw InputError("unexpected argument '" + a.positional[0] +
@@ -115,6 +120,18 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   if (o.screenshot && o.stats) throw InputError("--screenshot or --stats, not both");
   if (a.option("--after") && !o.screenshot) throw InputError("--after: only with --screenshot");
   if (a.option("--stats-after") && !o.stats) throw InputError("--stats-after: only with --stats");
+  if (auto v = a.option("--soak")) {
+    if (o.screenshot || o.stats) throw InputError("--soak: not with --screenshot or --stats");
+    o.soak = *v;
+    if (!a.option("--left")) o.left = "scripted";
+    if (!a.option("--right")) o.right = "scripted";
+  }
+  if (auto v = a.option("--soak-for")) {
+    if (!o.soak) throw InputError("--soak-for: only with --soak");
+    o.soak_for_s = number("--soak-for", *v, 5, 86400);
+  }
+  // A soak gives up only well after its own length (the drill in progress ends first).
+  if (o.soak && !a.option("--timeout")) o.timeout_s = o.soak_for_s + 600;
   return o;
 }
 

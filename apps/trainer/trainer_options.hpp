@@ -29,6 +29,11 @@ struct TrainerOptions {
   std::optional<std::filesystem::path> stats;
   double stats_after_s = 20.0;
   double timeout_s = 600.0;  // unattended modes give up (exit 3) after this many wall seconds
+  // Unattended soak (issue 18): drill after drill (the three drills in turn, scripted hands) for
+  // `soak_for_s` wall seconds, then the per-drill samples (memory, GL objects, haptic period) as
+  // JSON to `soak` (apps/trainer/trainer_soak.hpp).
+  std::optional<std::filesystem::path> soak;
+  double soak_for_s = 60.0;
 };
 
 extern const char* const kUsage;
