@@ -152,16 +152,16 @@ TEST(UdpBridge, CountsEveryFaultKeepsNewestGoodPoseAndFreezesWhenSilent) {
   Packet flipped = good;
   flipped[40] ^= 0x01;
   b.peer.send_raw(flipped);     // bad checksum
-  b.peer.send(pose(5, 55.0f));  // duplicate of the newest
+  b.peer.send(pose(5, 45.0f));  // duplicate of the newest
   b.peer.send(pose(7, 7.0f));   // ahead: accepted (6 "lost")
-  b.peer.send(pose(6, 66.0f));  // behind: out of order
-  PoseMessage old = pose(8, 88.0f);
+  b.peer.send(pose(6, 46.0f));  // behind: out of order
+  PoseMessage old = pose(8, 48.0f);
   old.sender_time_us -= 10'000'000;  // sent 10 s ago
   b.peer.send(old);                  // stale
-  b.peer.send(pose(8, 89.0f, 8));    // another device id
+  b.peer.send(pose(8, 49.0f, 8));    // another device id
   UdpBridgePeer intruder;
   intruder.set_device("127.0.0.1", b.device->local_port());
-  intruder.send(pose(9, 99.0f));  // another address:port
+  intruder.send(pose(9, 39.0f));  // another address:port
   b.peer.send(pose(10, 10.0f));   // the newest good one
   sent += 12;
 
