@@ -326,6 +326,48 @@ struct UdpHand {
   }
 };
 
+// Issue 18: when packets stop, the tool freezes and the force goes to zero within 5 ms. Ticks run
+// at the loop's period from the last packet's receive time, at several phases of the tick
+// against the packet; every tick up to the silence timeout still pushes (so the zero is the
+// silence's doing), and the first zero comes no later than 5 ms after the last packet.
+TEST(HapticSessionSilence, ForceIsZeroAndToolFrozenWithin5msOfTheLastPacket) {
+  HapticSession session(quiet_config());
+  UdpHand udp(session);
+  wall_model(session.model_slot(), 1);
+  session.publish_model();
+  const int64_t period = quiet_config().loop.period_ns;
+  const int64_t timeout_ns = std::llround(UdpBridgeConfig{}.silence_timeout_ms * 1e6);
+  int64_t k = 0;
+  for (const int64_t phase : {int64_t{0}, period / 4, period / 2, period - 1}) {
+    SCOPED_TRACE("tick phase " + std::to_string(phase) + " ns");
+    const float z = -0.2f - 0.01f * static_cast<float>(k % 7);
+    const int64_t last = udp.deliver(z);
+    ASSERT_GT(last, 0) << "no packet read back within the silence timeout in 1000 tries";
+    int64_t first_zero = -1;
+    for (int64_t t = last + phase; t <= last + 20 * kMs; t += period) {
+      session.step(tick_at(k++, t));
+      const Vec3 f = session.last_force(Hand::Right);
+      ToolPose pose;
+      ASSERT_TRUE(session.newest_pose(Hand::Right, pose));
+      EXPECT_FLOAT_EQ(static_cast<float>(pose.pos.z()), z) << "frozen at the last pose";
+      if (t - last <= timeout_ns) {
+        EXPECT_GT(f.z(), 1.0) << "live at " << (t - last) << " ns: the wall pushes";
+      } else if (first_zero < 0) {
+        first_zero = t - last;
+      }
+      if (first_zero >= 0) {
+        EXPECT_EQ(f, Vec3::Zero()) << "at " << (t - last) << " ns";
+      }
+    }
+    ASSERT_GE(first_zero, 0);
+    EXPECT_LE(first_zero, 5 * kMs) << "silence to zero force";
+  }
+  const HapticHandStats h = session.stats().hands[static_cast<size_t>(Hand::Right)];
+  EXPECT_GT(h.zero_force_ticks, 0u);
+  EXPECT_EQ(h.samples, 4u);
+  udp.device->stop();
+}
+
 TEST(HapticSessionBounds, UdpPacketsOutOfBoundsStopAtTheBridge) {
   HapticSession session(quiet_config());
   UdpHand udp(session, /*silence_ms=*/60'000);
