@@ -49,7 +49,7 @@ struct HapticHandStats {
   DeviceHealth health = DeviceHealth::Silent;
   DeviceCounters counters;
   uint64_t ticks = 0;            // ticks with this device
-  uint64_t samples = 0;          // new samples taken (seq changed)
+  uint64_t samples = 0;          // new samples taken (seq changed) within the bounds
   uint64_t samples_dropped = 0;  // ring full (the simulation did not drain it)
   // New samples that failed the bounds (sample_bounds.hpp), whatever the device: dropped before
   // the physics (the tool stays where the last good sample left it), or kept with grip/pedal
