@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <thread>
 #include <type_traits>
 
@@ -381,10 +382,17 @@ struct UdpBridgeDevice::Impl {
     const int64_t delay_us = static_cast<int64_t>(static_cast<uint64_t>(now_us) - m.sender_time_us);
     int64_t offset = delay_us;
     if (have_offset) {
-      // Let the minimum rise by 100 µs per s (1e-4) to follow a drifting peer clock.
-      const int64_t rise_us = (now - offset_update_ns) / 10'000'000;
-      offset = std::min(offset_us + rise_us, delay_us);
-      if (delay_us - offset > max_age_us) return bump(stale);
+      // Let the minimum rise by 100 µs per s (1e-4) to follow a drifting peer clock; saturated,
+      // since a peer may send any time at all and offset_us may sit near the int64 limits.
+      const int64_t rise_us = std::max<int64_t>(0, (now - offset_update_ns) / 10'000'000);
+      const int64_t risen = offset_us > std::numeric_limits<int64_t>::max() - rise_us
+                                ? std::numeric_limits<int64_t>::max()
+                                : offset_us + rise_us;
+      offset = std::min(risen, delay_us);
+      // offset <= delay_us, so the age is >= 0 but may exceed the int64 range (a peer's time
+      // jumping by more than 2^63 µs): the difference is taken unsigned, where it is exact.
+      const uint64_t age_us = static_cast<uint64_t>(delay_us) - static_cast<uint64_t>(offset);
+      if (age_us > static_cast<uint64_t>(max_age_us)) return bump(stale);
     }
     have_offset = true;
     offset_us = offset;

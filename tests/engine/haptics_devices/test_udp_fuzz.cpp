@@ -255,13 +255,13 @@ TEST(UdpFuzz, DecoderGivesEachMutationItsStatus) {
 struct Loopback {
   UdpBridgePeer peer, intruder;
   std::unique_ptr<UdpBridgeDevice> device;
-  Loopback() {
+  explicit Loopback(double silence_ms = 600'000) {
     UdpBridgeConfig c;
     c.bind_host = "127.0.0.1";
     c.peer_host = "127.0.0.1";
     c.peer_port = peer.local_port();
     c.device_id = 7;
-    c.silence_timeout_ms = 600'000;
+    c.silence_timeout_ms = silence_ms;
     c.max_age_ms = 5'000;
     device = std::make_unique<UdpBridgeDevice>(c);
     peer.set_device("127.0.0.1", device->local_port());
@@ -406,6 +406,64 @@ TEST(UdpFuzz, SocketPathCountsEveryBadPacketAndPassesTheGoodOnes) {
 }
 
 #undef PHACO_EXPECT_COUNTER
+
+// Valid packets whose sender time is anything at all (0, 2^63, 2^64 − 1, random, near ours): the
+// staleness arithmetic, modular differences between two clocks of any epochs, must not overflow
+// (UBSan checks that in CI) and no packet may vanish: each is accepted or stale, nothing else.
+// Which of the two depends on the times before it, so only the sum is checked; then the device
+// must still be usable: once silent, a good packet is accepted again.
+TEST(UdpFuzz, AnySenderTimeIsAcceptedOrStaleAndTheDeviceRecovers) {
+  const uint64_t seed = fuzz_seed();
+  const CounterRng rng(seed, /*stream=*/3);
+  Loopback net(/*silence_ms=*/20);
+  constexpr int kTimes = 20'000, kBatch = 64;
+  uint32_t seq = 0;
+  for (int i = 0; i < kTimes; ++i) {
+    Draws d{rng, static_cast<uint64_t>(i)};
+    PoseMessage m = good_pose(d, ++seq);
+    switch (d.below(8)) {
+      case 0:
+        m.sender_time_us = 0;
+        break;
+      case 1:
+        m.sender_time_us = ~uint64_t{0};
+        break;
+      case 2:
+        m.sender_time_us = uint64_t{1} << 63;
+        break;
+      case 3:
+        m.sender_time_us = (uint64_t{1} << 63) - 1;
+        break;
+      case 4:  // near ours, up to ±2^40 µs (12 days) off
+        m.sender_time_us += (uint64_t{d.u32()} << 8) - (uint64_t{1} << 39);
+        break;
+      default:
+        m.sender_time_us = (uint64_t{d.u32()} << 32) | d.u32();
+        break;
+    }
+    net.peer.send(m);
+    if ((i + 1) % kBatch == 0 || i + 1 == kTimes) {
+      ASSERT_TRUE(net.wait_seen(static_cast<uint64_t>(i) + 1)) << "seed " << seed;
+    }
+  }
+  DeviceCounters c = net.device->counters();
+  EXPECT_EQ(c.accepted + c.stale, static_cast<uint64_t>(kTimes)) << "seed " << seed;
+  EXPECT_EQ(c.packets(), static_cast<uint64_t>(kTimes));
+  EXPECT_GT(c.stale, 0u) << "the times were wild enough to make some stale";
+
+  // Silent (by the device's own clock), then a good packet: resynchronised and accepted.
+  const int64_t give_up = now_ns() + 10'000'000'000;
+  while (net.device->health(now_ns()) != DeviceHealth::Silent && now_ns() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_EQ(net.device->health(now_ns()), DeviceHealth::Silent);
+  Draws d{rng, kTimes};
+  net.peer.send(good_pose(d, ++seq));
+  ASSERT_TRUE(net.wait_seen(static_cast<uint64_t>(kTimes) + 1));
+  EXPECT_EQ(net.device->counters().accepted, c.accepted + 1)
+      << "after a silence the first good packet is accepted, whatever the times before it";
+  net.device->stop();
+}
 
 }  // namespace
 }  // namespace phaco
