@@ -302,7 +302,7 @@ std::string udp_section(const UdpBridgeRow& r, const std::filesystem::path& dir)
   md +=
       "| s | sent | accepted | dropped | forces back | round trip p50 / p99 / max (us) | silence "
       "timeout (ms) | "
-      "timeout → zero force at the peer (ms) |\n|---|---|---|---|---|---|---|---|\n";
+      "last pose → zero force at the peer (ms) |\n|---|---|---|---|---|---|---|---|\n";
   md += "| " + fmt("%.0f", r.seconds) + " | " + fmt("%.0f", r.sent) + " | " +
         fmt("%.0f", r.accepted) + " | " + fmt("%.0f", r.dropped) + " | " +
         fmt("%.0f", r.forces_received) + " | " + fmt("%.0f", r.round_trip_p50_us) + " / " +
@@ -310,7 +310,7 @@ std::string udp_section(const UdpBridgeRow& r, const std::filesystem::path& dir)
         fmt("%.0f", r.silence_timeout_ms) + " | " +
         (r.silence_to_zero_ms < 0 ? std::string("not seen") : fmt("%.2f", r.silence_to_zero_ms)) +
         " |\n\n";
-  md += "Target: force zero within 5 ms of the timeout: " +
+  md += "Target: force zero at the peer within 5 ms of the last pose sent: " +
         met(r.silence_to_zero_ms >= 0 && r.silence_to_zero_ms <= 5.0) + ".\n\n";
   return md;
 }

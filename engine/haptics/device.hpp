@@ -15,17 +15,18 @@
 #include <vector>
 
 #include "engine/core/math.hpp"
+#include "engine/core/workspace.hpp"
 #include "engine/io/track.hpp"
 
 namespace phaco {
 
 struct DeviceLimits {
-  double max_force_mn = 3300;                   // mN, peak force the device can render
-  double max_stiffness_mn_per_mm = 1000;        // mN/mm, stiffest spring it renders stably
-  double max_damping_mn_s_per_mm = 2;           // mN·s/mm
-  Vec3 workspace_min_mm = Vec3::Constant(-50);  // mm, box the pose stays in (device frame)
-  Vec3 workspace_max_mm = Vec3::Constant(50);   // mm
-  bool has_force = true;                        // false: a tracker only, forces are ignored
+  double max_force_mn = 3300;             // mN, peak force the device can render
+  double max_stiffness_mn_per_mm = 1000;  // mN/mm, stiffest spring it renders stably
+  double max_damping_mn_s_per_mm = 2;     // mN·s/mm
+  Vec3 workspace_min_mm = Vec3::Constant(-kWorkspaceHalfMm);  // mm, box the pose stays in
+  Vec3 workspace_max_mm = Vec3::Constant(kWorkspaceHalfMm);   // mm (device frame)
+  bool has_force = true;  // false: a tracker only, forces are ignored
 };
 
 struct DeviceSample {
@@ -57,20 +58,24 @@ std::string_view to_string(DeviceHealth health);
 
 // What a device accepted and why it dropped the rest. Only the UDP bridge fills most of these.
 struct DeviceCounters {
-  uint64_t accepted = 0;       // samples taken
-  uint64_t malformed = 0;      // wrong size, wrong magic, unknown type, non-finite values
-  uint64_t bad_checksum = 0;   // CRC-32 mismatch
-  uint64_t wrong_version = 0;  // protocol version we do not speak
-  uint64_t wrong_peer = 0;     // from another address:port, or another device id
-  uint64_t duplicate = 0;      // seq equal to the newest accepted
-  uint64_t out_of_order = 0;   // seq behind the newest accepted (wrap-around aware)
-  uint64_t stale = 0;          // too old on arrival (see docs/udp_bridge_protocol.md)
-  uint64_t silences = 0;       // times the haptic thread saw the device go silent
-  // Every packet seen, each in exactly one of the counters above except silences.
+  uint64_t accepted = 0;          // samples taken
+  uint64_t malformed = 0;         // wrong size, wrong magic, unknown type
+  uint64_t bad_checksum = 0;      // CRC-32 mismatch
+  uint64_t wrong_version = 0;     // protocol version we do not speak
+  uint64_t wrong_peer = 0;        // from another address:port, or another device id
+  uint64_t non_finite = 0;        // a NaN or infinite number, or a zero quaternion
+  uint64_t out_of_workspace = 0;  // a position beyond ±kWorkspaceHalfMm (sample_bounds.hpp)
+  uint64_t duplicate = 0;         // seq equal to the newest accepted
+  uint64_t out_of_order = 0;      // seq behind the newest accepted (wrap-around aware)
+  uint64_t stale = 0;             // too old on arrival (see docs/udp_bridge_protocol.md)
+  uint64_t clamped = 0;   // accepted with grip or pedal clamped into range (also in accepted)
+  uint64_t silences = 0;  // times the haptic thread saw the device go silent
+  // Every packet seen, each in exactly one of the counters above except clamped and silences.
   uint64_t packets() const {
-    return accepted + malformed + bad_checksum + wrong_version + wrong_peer + duplicate +
-           out_of_order + stale;
+    return accepted + malformed + bad_checksum + wrong_version + wrong_peer + non_finite +
+           out_of_workspace + duplicate + out_of_order + stale;
   }
+  uint64_t dropped() const { return packets() - accepted; }
 };
 
 // Options of the devices that play a scenario track (scripted: interpolated; replay: as recorded).

@@ -36,7 +36,7 @@ struct DeviceSpec {
 struct DeviceContext {
   const Scenario* scenario = nullptr;
   Hand hand = Hand::Right;
-  double silence_timeout_ms = 50;  // udp
+  double silence_timeout_ms = 3;  // udp: UdpBridgeConfig's default, see udp_bridge.hpp
 };
 
 DeviceSpec parse_device_spec(std::string_view text);  // throws InputError

@@ -5,31 +5,28 @@
 #include <fstream>
 
 #include "engine/core/error.hpp"
+#include "engine/haptics/sample_bounds.hpp"
 
 namespace phaco {
-
-namespace {
-
-constexpr double kMaxGrip = 1.0;  // as the scenario loader checks
-constexpr double kMaxPedal = 3.0;
-
-}  // namespace
 
 DeviceRecorder::DeviceRecorder(std::size_t capacity) : capacity_(capacity) {
   samples_.reserve(capacity_);
 }
 
 bool DeviceRecorder::record(const DeviceSample& s) noexcept {
-  const bool first = !any_;
-  if (!first && (s.seq == last_seq_ || s.t_ns <= last_ns_)) return false;  // seen already
-  if (!s.pos_mm.allFinite() || !s.quat.coeffs().allFinite() || !std::isfinite(s.grip) ||
-      !std::isfinite(s.pedal) || s.quat.norm() < 1e-9) {
+  if (seen_ && (s.seq == last_seq_ || s.t_ns <= last_ns_)) return false;  // seen already
+  // A rejected sample is seen too: read again on the next tick, it is not counted again.
+  seen_ = true;
+  last_seq_ = s.seq;
+  last_ns_ = s.t_ns;
+  // The session's bounds (sample_bounds.hpp): a recording never holds what the physics would not
+  // take, and always loads back (the scenario loader checks the same ranges).
+  DeviceSample b = s;
+  if (!keeps(bound_sample(b))) {
     ++rejected_;
     return false;
   }
-  last_seq_ = s.seq;
-  last_ns_ = s.t_ns;
-  if (first) origin_ns_ = s.t_ns;
+  if (!any_) origin_ns_ = s.t_ns;
   any_ = true;
   if (samples_.size() >= capacity_) {
     ++dropped_;
@@ -37,10 +34,10 @@ bool DeviceRecorder::record(const DeviceSample& s) noexcept {
   }
   TrackSample x;
   x.t = static_cast<double>(s.t_ns - origin_ns_) * 1e-9;
-  x.pos = s.pos_mm;
-  x.quat = s.quat.normalized();
-  x.grip = std::clamp(s.grip, 0.0, kMaxGrip);
-  x.pedal = std::clamp(s.pedal, 0.0, kMaxPedal);
+  x.pos = b.pos_mm;
+  x.quat = b.quat.normalized();
+  x.grip = b.grip;
+  x.pedal = b.pedal;
   samples_.push_back(x);  // within the reserved capacity: no allocation
   return true;
 }

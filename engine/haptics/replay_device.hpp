@@ -4,9 +4,10 @@
 // DeviceRecorder keeps the distinct samples read from any device (a new seq, a later time) in a
 // buffer allocated up front, so recording on the haptic thread never allocates; beyond capacity
 // samples are dropped and counted. It writes them as a scenario hand track: t = receive time −
-// first sample's receive time, quat normalised, grip/pedal clamped to their ranges (what the
-// scenario loader accepts, so a written recording loads back bit for bit). Buttons and seq are
-// not part of the scenario format and are not recorded.
+// first sample's receive time, quat normalised, grip/pedal clamped to their ranges; a sample that
+// fails the session's bounds (sample_bounds.hpp: non-finite, outside the workspace) is rejected
+// and counted (what the scenario loader accepts, so a written recording loads back bit for bit).
+// Buttons and seq are not part of the scenario format and are not recorded.
 //
 // ReplayDevice plays such a track exactly as recorded: sample-and-hold at the recorded times (no
 // interpolation, unlike ScriptedDevice), seq = sample index + 1, t_ns = start + recorded time.
@@ -34,7 +35,7 @@ class DeviceRecorder {
   std::size_t size() const { return samples_.size(); }
   std::size_t capacity() const { return capacity_; }
   uint64_t dropped() const { return dropped_; }     // new samples beyond capacity
-  uint64_t rejected() const { return rejected_; }   // non-finite values
+  uint64_t rejected() const { return rejected_; }   // new samples failing bound_sample
   int64_t origin_ns() const { return origin_ns_; }  // receive time of t = 0
   std::span<const TrackSample> samples() const { return samples_; }
 
@@ -53,7 +54,8 @@ class DeviceRecorder {
   int64_t origin_ns_ = 0;
   int64_t last_ns_ = 0;
   uint32_t last_seq_ = 0;
-  bool any_ = false;  // a sample was seen (origin_ns_ is set)
+  bool seen_ = false;  // a sample was offered (last_seq_, last_ns_ are set)
+  bool any_ = false;   // a sample was kept (origin_ns_ is set)
   uint64_t dropped_ = 0, rejected_ = 0;
 };
 

@@ -12,11 +12,13 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <thread>
 #include <type_traits>
 
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
+#include "engine/haptics/sample_bounds.hpp"
 
 namespace phaco {
 
@@ -282,18 +284,6 @@ bool same_endpoint(const sockaddr_in& a, const sockaddr_in& b) {
   return a.sin_addr.s_addr == b.sin_addr.s_addr && a.sin_port == b.sin_port;
 }
 
-bool finite_pose(const PoseMessage& m) {
-  for (float v : m.pos_mm) {
-    if (!std::isfinite(v)) return false;
-  }
-  double n2 = 0;
-  for (float v : m.quat) {
-    if (!std::isfinite(v)) return false;
-    n2 += double(v) * v;
-  }
-  return n2 > 1e-12 && std::isfinite(m.grip) && std::isfinite(m.pedal);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -324,7 +314,8 @@ struct UdpBridgeDevice::Impl {
   // Counters: written by the I/O thread (silences by the haptic thread), read by anyone.
   // Relaxed: statistics, ordering nothing.
   std::atomic<uint64_t> accepted{0}, malformed{0}, bad_checksum{0}, wrong_version{0}, wrong_peer{0},
-      duplicate{0}, out_of_order{0}, stale{0}, silences{0};
+      non_finite{0}, out_of_workspace{0}, duplicate{0}, out_of_order{0}, stale{0}, clamped{0},
+      silences{0};
 
   // I/O thread only.
   bool have_seq = false;
@@ -364,7 +355,16 @@ struct UdpBridgeDevice::Impl {
         return bump(malformed);
     }
     if (config.device_id != 0 && m.device_id != config.device_id) return bump(wrong_peer);
-    if (!finite_pose(m)) return bump(malformed);
+    // The bounds every device sample meets (engine/haptics/sample_bounds.hpp), checked here too
+    // so that a bad packet is counted as the packet it was and never becomes the newest sample.
+    DeviceSample s;
+    s.pos_mm = Vec3(m.pos_mm[0], m.pos_mm[1], m.pos_mm[2]);
+    s.quat = Quat(m.quat[0], m.quat[1], m.quat[2], m.quat[3]);
+    s.grip = m.grip;
+    s.pedal = m.pedal;
+    const SampleCheck bounds = bound_sample(s);
+    if (bounds == SampleCheck::NonFinite) return bump(non_finite);
+    if (bounds == SampleCheck::OutsideWorkspace) return bump(out_of_workspace);
 
     if (silent(now)) {  // after a silence the peer may have restarted: resynchronise
       have_seq = false;
@@ -382,10 +382,17 @@ struct UdpBridgeDevice::Impl {
     const int64_t delay_us = static_cast<int64_t>(static_cast<uint64_t>(now_us) - m.sender_time_us);
     int64_t offset = delay_us;
     if (have_offset) {
-      // Let the minimum rise by 100 µs per s (1e-4) to follow a drifting peer clock.
-      const int64_t rise_us = (now - offset_update_ns) / 10'000'000;
-      offset = std::min(offset_us + rise_us, delay_us);
-      if (delay_us - offset > max_age_us) return bump(stale);
+      // Let the minimum rise by 100 µs per s (1e-4) to follow a drifting peer clock; saturated,
+      // since a peer may send any time at all and offset_us may sit near the int64 limits.
+      const int64_t rise_us = std::max<int64_t>(0, (now - offset_update_ns) / 10'000'000);
+      const int64_t risen = offset_us > std::numeric_limits<int64_t>::max() - rise_us
+                                ? std::numeric_limits<int64_t>::max()
+                                : offset_us + rise_us;
+      offset = std::min(risen, delay_us);
+      // offset <= delay_us, so the age is >= 0 but may exceed the int64 range (a peer's time
+      // jumping by more than 2^63 µs): the difference is taken unsigned, where it is exact.
+      const uint64_t age_us = static_cast<uint64_t>(delay_us) - static_cast<uint64_t>(offset);
+      if (age_us > static_cast<uint64_t>(max_age_us)) return bump(stale);
     }
     have_offset = true;
     offset_us = offset;
@@ -397,16 +404,15 @@ struct UdpBridgeDevice::Impl {
     p.t_ns = now;
     p.seq = m.seq;
     p.buttons = m.buttons;
-    for (int i = 0; i < 3; ++i) p.pos[i] = m.pos_mm[i];
-    const double n = std::sqrt(double(m.quat[0]) * m.quat[0] + double(m.quat[1]) * m.quat[1] +
-                               double(m.quat[2]) * m.quat[2] + double(m.quat[3]) * m.quat[3]);
-    for (int i = 0; i < 4; ++i) p.quat[i] = m.quat[i] / n;  // f32 on the wire: renormalise
-    p.grip = std::clamp(double(m.grip), 0.0, 1.0);
-    p.pedal = std::clamp(double(m.pedal), 0.0, 3.0);
+    for (int i = 0; i < 3; ++i) p.pos[i] = s.pos_mm[i];
+    p.quat[0] = s.quat.w(), p.quat[1] = s.quat.x(), p.quat[2] = s.quat.y(), p.quat[3] = s.quat.z();
+    p.grip = s.grip;
+    p.pedal = s.pedal;
     p.sender_time_us = m.sender_time_us;
     pose.store(p);
     last_accept_ns.store(now, std::memory_order_relaxed);
     bump(accepted);
+    if (bounds == SampleCheck::Clamped) bump(clamped);
   }
 
   void send_force(const ForcePayload& f, bool zero, DeviceHealth h, int64_t now) {
@@ -568,9 +574,12 @@ DeviceCounters UdpBridgeDevice::counters() const {
   c.bad_checksum = r(d.bad_checksum);
   c.wrong_version = r(d.wrong_version);
   c.wrong_peer = r(d.wrong_peer);
+  c.non_finite = r(d.non_finite);
+  c.out_of_workspace = r(d.out_of_workspace);
   c.duplicate = r(d.duplicate);
   c.out_of_order = r(d.out_of_order);
   c.stale = r(d.stale);
+  c.clamped = r(d.clamped);
   c.silences = r(d.silences);
   return c;
 }

@@ -11,10 +11,12 @@
 // The I/O thread owns the socket (poll with a 1 ms timeout); the haptic thread touches only
 // atomics: read/write_force/health make no system call other than the clock. The device is
 // bound to one configured peer (IPv4 address:port); anything else is dropped and counted.
-// Silence: no accepted packet for more than silence_timeout_ms → health() says Silent, read()
-// returns the last good pose (frozen) and force goes out as zero; seen by the haptic thread at
-// its next tick after the timeout. Good packets resume it (after a silence any sequence number is
-// accepted, so a restarted peer resynchronises).
+// Silence (issue 18: frozen and zero force within 5 ms of the last packet): no accepted packet for
+// more than silence_timeout_ms (3 ms) → health() says Silent, read() returns the last good pose
+// (frozen) and write_force stores zero; the 1 kHz haptic thread sees it at its first tick after
+// the timeout (≤ 4 ms after the last packet) and the I/O thread sends the zero within its 1 ms
+// poll. Good packets resume it (after a silence any sequence number is accepted, so a restarted
+// peer resynchronises).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -61,6 +63,7 @@ struct ForceMessage {
   bool operator==(const ForceMessage&) const = default;
 };
 
+// What decode() found; the device also drops decoded packets for the reasons in DeviceCounters.
 enum class DecodeStatus : uint8_t { Ok, Malformed, WrongVersion, BadChecksum, WrongType };
 
 // CRC-32/ISO-HDLC (the zlib/PNG/Ethernet CRC): reflected polynomial 0xEDB88320, init and final
@@ -81,8 +84,10 @@ struct UdpBridgeConfig {
   uint16_t local_port = 0;              // 0: an ephemeral port (see local_port())
   std::string peer_host = "127.0.0.1";  // IPv4 address or host name (resolved once, IPv4)
   uint16_t peer_port = 0;
-  uint32_t device_id = 0;          // 0: accept any; else other ids count as wrong_peer
-  double silence_timeout_ms = 50;  // no accepted packet for longer → Silent
+  uint32_t device_id = 0;  // 0: accept any; else other ids count as wrong_peer
+  // No accepted packet for longer → Silent. 3 ms: two lost packets at 1 kHz are ridden through,
+  // and the zero force still reaches the peer within 5 ms of the last packet (see above).
+  double silence_timeout_ms = 3;
   // A packet is stale when its one-way age exceeds this: age = (receive time − sender time) −
   // the smallest such difference seen (the clock offset plus the base delay), that minimum
   // allowed to rise by 100 µs per s to follow clock drift.

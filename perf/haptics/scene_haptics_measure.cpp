@@ -186,8 +186,8 @@ UdpBridgeRow measure_udp_bridge(double seconds, double silence_timeout_ms) {
         if (f->ack_sender_time_us) round_trips.push_back(double(now - f->ack_sender_time_us));
       } else if (silence_to_zero_ms < 0 && f->health != 0 &&
                  f->force_mn == std::array<float, 3>{0, 0, 0}) {
-        const double expiry_us = double(last_send_us.load()) + silence_timeout_ms * 1e3;
-        silence_to_zero_ms = (double(now) - expiry_us) * 1e-3;
+        // From the last pose sent (issue 18: zero force within 5 ms of silence, timeout included).
+        silence_to_zero_ms = (double(now) - double(last_send_us.load())) * 1e-3;
       }
     }
   });

@@ -48,8 +48,9 @@ struct UdpBridgeRow {
   double round_trip_p50_us = 0, round_trip_p99_us = 0,
          round_trip_max_us = 0;  // pose sent → its force back
   double silence_timeout_ms = 0;
-  double silence_to_zero_ms = 0;  // timeout expiry → the first zero force the peer receives
+  double silence_to_zero_ms = 0;  // the last pose sent → the first zero force the peer receives
 };
-UdpBridgeRow measure_udp_bridge(double seconds, double silence_timeout_ms = 50);
+// 3 ms: UdpBridgeConfig's default silence timeout.
+UdpBridgeRow measure_udp_bridge(double seconds, double silence_timeout_ms = 3);
 
 }  // namespace phaco::perf

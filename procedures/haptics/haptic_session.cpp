@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "engine/core/clock.hpp"
+#include "engine/haptics/sample_bounds.hpp"
 
 namespace phaco {
 namespace {
@@ -86,8 +87,27 @@ void HapticSession::tick(const TickInfo& info) {
     const int64_t now = info.wake_ns;
     DeviceSample s;
     bool new_sample = false;
-    if (device.read(now, s) && (!h.have_sample || s.seq != h.last_seq)) {
-      new_sample = true;
+    if (device.read(now, s) && (!h.read_any || s.seq != h.last_seq)) {
+      h.read_any = true;
+      h.last_seq = s.seq;  // a dropped sample read again next tick is not counted again
+      switch (bound_sample(s)) {
+        case SampleCheck::Ok:
+          new_sample = true;
+          break;
+        case SampleCheck::Clamped:
+          new_sample = true;
+          h.samples_clamped.fetch_add(1, std::memory_order_relaxed);
+          break;
+        case SampleCheck::NonFinite:
+          h.non_finite.fetch_add(1, std::memory_order_relaxed);
+          break;
+        case SampleCheck::OutsideWorkspace:
+          h.outside_workspace.fetch_add(1, std::memory_order_relaxed);
+          break;
+      }
+    }
+    // A dropped sample changes nothing below: the tool and the force follow the last good one.
+    if (new_sample) {
       if (h.have_sample && s.t_ns > h.last_sample_ns) {
         const Vec3 v =
             (s.pos_mm - h.last_pos) / (static_cast<double>(s.t_ns - h.last_sample_ns) * 1e-9);
@@ -95,7 +115,6 @@ void HapticSession::tick(const TickInfo& info) {
       }
       h.sample = s;
       h.have_sample = true;
-      h.last_seq = s.seq;
       h.last_sample_ns = s.t_ns;
       h.last_pos = s.pos_mm;
       h.ring->try_push(RingSample{
@@ -120,9 +139,9 @@ void HapticSession::tick(const TickInfo& info) {
       h.zero_force_ticks.fetch_add(1, std::memory_order_relaxed);
       h.velocity = Vec3::Zero();
     }
-    const int64_t written = now_ns();
-    device.write_force(force, written);
-    if (new_sample) h.latency.record(written - h.sample.t_ns);
+    // The device judges its health at the same instant as above, so the two never disagree.
+    device.write_force(force, now);
+    if (new_sample) h.latency.record(now_ns() - h.sample.t_ns);
 
     raise_to(h.max_force_mn, force.norm());
     raise_to(h.max_force_step_mn, (force - h.force).norm());
@@ -131,6 +150,11 @@ void HapticSession::tick(const TickInfo& info) {
     h.force_y.store(static_cast<float>(force.y()), std::memory_order_relaxed);
     h.force_z.store(static_cast<float>(force.z()), std::memory_order_relaxed);
   }
+}
+
+void HapticSession::step(const TickInfo& info) {
+  if (running()) throw std::logic_error("HapticSession::step: the 1 kHz thread is running");
+  tick(info);
 }
 
 bool HapticSession::newest_pose(Hand hand, ToolPose& pose) {
@@ -182,6 +206,9 @@ HapticSessionStats HapticSession::stats() const {
     s.ticks = h.ticks.load(std::memory_order_relaxed);
     s.samples = h.samples.load(std::memory_order_relaxed);
     s.samples_dropped = h.ring->dropped();
+    s.samples_non_finite = h.non_finite.load(std::memory_order_relaxed);
+    s.samples_outside_workspace = h.outside_workspace.load(std::memory_order_relaxed);
+    s.samples_clamped = h.samples_clamped.load(std::memory_order_relaxed);
     s.zero_force_ticks = h.zero_force_ticks.load(std::memory_order_relaxed);
     s.models_adopted = h.adopted.load(std::memory_order_relaxed);
     s.clamped_ticks = h.clamped.load(std::memory_order_relaxed);

@@ -2,7 +2,9 @@
 // The haptic runtime (DESIGN.md §5, issue 6): one 1 kHz thread (engine/haptics/haptic_loop) that,
 // every tick and for each hand with a device,
 //
-//   reads the device's newest sample ──▶ SPSC ring ──▶ the simulation drains it (newest_pose)
+//   reads the device's newest sample, checks its bounds (engine/haptics/sample_bounds.hpp: a
+//     non-finite or out-of-workspace sample is dropped and counted, grip/pedal clamped)
+//     ──▶ SPSC ring ──▶ the simulation drains it (newest_pose)
 //   takes the newest local model, if one was published (triple buffer, acquire)
 //   computes the force from it alone (systems/haptic_model: proxy, local nodes, grasp, lens)
 //   writes the force to the device, zero when the device is silent or failed (its tool frozen)
@@ -46,9 +48,13 @@ struct HapticHandStats {
   bool attached = false;
   DeviceHealth health = DeviceHealth::Silent;
   DeviceCounters counters;
-  uint64_t ticks = 0;             // ticks with this device
-  uint64_t samples = 0;           // new samples taken (seq changed)
-  uint64_t samples_dropped = 0;   // ring full (the simulation did not drain it)
+  uint64_t ticks = 0;            // ticks with this device
+  uint64_t samples = 0;          // new samples taken (seq changed) within the bounds
+  uint64_t samples_dropped = 0;  // ring full (the simulation did not drain it)
+  // New samples that failed the bounds (sample_bounds.hpp), whatever the device: dropped before
+  // the physics (the tool stays where the last good sample left it), or kept with grip/pedal
+  // clamped.
+  uint64_t samples_non_finite = 0, samples_outside_workspace = 0, samples_clamped = 0;
   uint64_t zero_force_ticks = 0;  // ticks the device was silent or failed: force zero, tool frozen
   uint64_t models_adopted = 0, clamped_ticks = 0, rejected_inputs = 0;
   double max_force_mn = 0;       // largest force sent
@@ -79,6 +85,11 @@ class HapticSession final : public HapticPort {
   bool running() const { return loop_.running(); }
 
   HapticSessionStats stats() const;
+  // One tick on the calling thread at the caller's time (info.wake_ns is "now" for the devices),
+  // instead of the 1 kHz thread: deterministic tests of what a tick does at a given instant (the
+  // silence bound). Only while the session is not running; throws std::logic_error otherwise.
+  void step(const TickInfo& info);
+
   // The 1 kHz thread's period histogram (occupied bins), for the harness's charts.
   std::vector<DurationHistogram::Bin> period_bins() const { return loop_.period_bins(); }
 
@@ -110,7 +121,8 @@ class HapticSession final : public HapticPort {
     std::unique_ptr<SpscRing<RingSample, kRingCapacity>> ring;
     // Haptic thread only.
     DeviceSample sample;
-    bool have_sample = false;
+    bool have_sample = false;  // a sample passed the bounds: `sample` holds the newest such
+    bool read_any = false;     // the device gave a sample (good or not): last_seq is its seq
     uint32_t last_seq = 0;
     int64_t last_sample_ns = 0;
     Vec3 last_pos = Vec3::Zero(), velocity = Vec3::Zero();
@@ -118,7 +130,7 @@ class HapticSession final : public HapticPort {
     DurationHistogram latency;
     // Written by the haptic thread, read by stats() (relaxed: figures, not synchronisation).
     std::atomic<uint64_t> ticks{0}, samples{0}, zero_force_ticks{0}, adopted{0}, clamped{0},
-        rejected{0};
+        rejected{0}, non_finite{0}, outside_workspace{0}, samples_clamped{0};
     std::atomic<double> max_force_mn{0}, max_force_step_mn{0};
     std::atomic<float> force_x{0}, force_y{0}, force_z{0};
     // Simulation thread only.

@@ -101,7 +101,8 @@ RealtimeRunReport run_realtime(const Scenario& scenario, SceneOptions options,
   const HapticSessionStats running = session.stats();  // the devices' health while they ran
   session.stop();
   report.haptics = session.stats();
-  for (size_t k = 0; k < kHapticTools; ++k) report.haptics.hands[k].health = running.hands[k].health;
+  for (size_t k = 0; k < kHapticTools; ++k)
+    report.haptics.hands[k].health = running.hands[k].health;
   report.frame_max_ms = costs.empty() ? 0 : *std::max_element(costs.begin(), costs.end());
   report.frame_p99_ms = percentile(costs, 0.99);
   report.frame_p50_ms = percentile(costs, 0.50);
@@ -120,6 +121,10 @@ nlohmann::json to_json(const HapticSessionStats& s) {
         {"ticks", h.ticks},
         {"samples", h.samples},
         {"samples_dropped", h.samples_dropped},
+        {"samples_out_of_bounds",
+         {{"non_finite", h.samples_non_finite},
+          {"outside_workspace", h.samples_outside_workspace},
+          {"clamped", h.samples_clamped}}},
         {"zero_force_ticks", h.zero_force_ticks},
         {"models_adopted", h.models_adopted},
         {"clamped_ticks", h.clamped_ticks},
@@ -133,9 +138,12 @@ nlohmann::json to_json(const HapticSessionStats& s) {
           {"bad_checksum", c.bad_checksum},
           {"wrong_version", c.wrong_version},
           {"wrong_peer", c.wrong_peer},
+          {"non_finite", c.non_finite},
+          {"out_of_workspace", c.out_of_workspace},
           {"duplicate", c.duplicate},
           {"out_of_order", c.out_of_order},
           {"stale", c.stale},
+          {"clamped", c.clamped},
           {"silences", c.silences}}}};
   }
   return {{"realtime",
@@ -197,12 +205,17 @@ std::string summary_text(const RealtimeRunReport& r) {
     std::snprintf(
         buf, sizeof buf,
         "%s hand: %s; %llu samples, %llu zero-force ticks, max force %.1f mN, max step %.2f mN; "
-        "packets accepted %llu, dropped %llu\n",
+        "packets accepted %llu, dropped %llu\n  samples out of bounds: %llu dropped (%llu "
+        "non-finite, %llu outside the workspace), %llu clamped\n",
         std::string(to_string(static_cast<Hand>(k))).c_str(),
         std::string(to_string(h.health)).c_str(), static_cast<unsigned long long>(h.samples),
         static_cast<unsigned long long>(h.zero_force_ticks), h.max_force_mn, h.max_force_step_mn,
         static_cast<unsigned long long>(h.counters.accepted),
-        static_cast<unsigned long long>(h.counters.packets() - h.counters.accepted));
+        static_cast<unsigned long long>(h.counters.dropped()),
+        static_cast<unsigned long long>(h.samples_non_finite + h.samples_outside_workspace),
+        static_cast<unsigned long long>(h.samples_non_finite),
+        static_cast<unsigned long long>(h.samples_outside_workspace),
+        static_cast<unsigned long long>(h.samples_clamped));
     out += buf;
     out += line("latency", h.latency);
   }

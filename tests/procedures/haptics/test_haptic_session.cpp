@@ -6,10 +6,17 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <thread>
 
 #include "engine/core/clock.hpp"
 #include "engine/haptics/device.hpp"
+#include "engine/haptics/recording_device.hpp"
+#include "engine/haptics/replay_device.hpp"
+#include "engine/haptics/sample_bounds.hpp"
+#include "engine/haptics/scripted_device.hpp"
+#include "engine/haptics/udp_bridge.hpp"
 #include "procedures/haptics/haptic_session.hpp"
 #include "tests/engine/haptics/alloc_counter.hpp"
 
@@ -180,6 +187,213 @@ TEST(HapticSession, TheHapticThreadAllocatesNothingOnceRunning) {
   session.stop();
   test::close_allocation_window();
   EXPECT_EQ(allocations, 0) << "the haptic thread allocated";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Deterministic ticks (HapticSession::step): each tick runs at a given instant, no thread.
+
+constexpr int64_t kMs = 1'000'000;
+
+TickInfo tick_at(int64_t k, int64_t t) {
+  return TickInfo{k, t, t};
+}
+
+// A track for the right hand: pressing into the wall, then samples the bounds must catch, each
+// held 2 ms, then pressing again with the pedal out of range (clamped, kept).
+HandTrack faulty_track() {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  HandTrack h;
+  h.hand = Hand::Right;
+  auto at = [&](double t_ms, Vec3 pos, double pedal = 0) {
+    TrackSample x;
+    x.t = t_ms * 1e-3, x.pos = pos, x.pedal = pedal;
+    h.track.push_back(x);
+  };
+  at(0, Vec3(0, 0, -0.2));                   // seq 1: good, in contact
+  at(2, Vec3(1.2e19, 0, 0));                 // seq 2: outside the workspace
+  at(4, Vec3(0, kNaN, 0));                   // seq 3: non-finite
+  at(6, Vec3(0, 0, -kWorkspaceHalfMm - 1));  // seq 4: outside, just
+  at(8, Vec3(0.5, 0, -0.3), 7.0);            // seq 5: good, pedal clamped to 3
+  return h;
+}
+
+// Steps `session` at start + k ms, k = 0..9, checking after every tick that nothing out of
+// bounds reached the simulation's side or the force.
+void step_and_check(HapticSession& session, int64_t start) {
+  for (int64_t k = 0; k < 10; ++k) {
+    session.step(tick_at(k, start + k * kMs));
+    ToolPose pose;
+    ASSERT_TRUE(session.newest_pose(Hand::Right, pose)) << "tick " << k;
+    EXPECT_TRUE(pose.pos.allFinite()) << "tick " << k;
+    EXPECT_LE(pose.pos.cwiseAbs().maxCoeff(), kWorkspaceHalfMm) << "tick " << k;
+    EXPECT_LE(pose.pedal, kMaxPedal) << "tick " << k;
+    // Dropped samples leave the tool where the good one had it: still pressing, still pushed.
+    EXPECT_LT(pose.pos.z(), 0.0) << "tick " << k;
+    const Vec3 f = session.last_force(Hand::Right);
+    EXPECT_TRUE(f.allFinite()) << "tick " << k;
+    EXPECT_GT(f.z(), 1.0) << "tick " << k << ": the wall still pushes on the last good pose";
+  }
+}
+
+// `dev` started at `start` in the right hand, the wall published.
+void attach_at_the_wall(HapticSession& session, std::unique_ptr<Device> dev, int64_t start) {
+  dev->start(start);
+  session.attach(Hand::Right, std::move(dev));
+  wall_model(session.model_slot(), 1);
+  session.publish_model();
+}
+
+TEST(HapticSessionBounds, ReplayAndRecordingDropAndCountOutOfBoundsSamples) {
+  DeviceRecorder recorder(64);
+  for (const bool recording : {false, true}) {
+    SCOPED_TRACE(recording ? "recording passthrough of a replay" : "replay");
+    HapticSession session(quiet_config());
+    std::unique_ptr<Device> dev = std::make_unique<ReplayDevice>(faulty_track());
+    if (recording) dev = recording_device(std::move(dev), recorder);
+    const int64_t start = 1'000 * kMs;
+    attach_at_the_wall(session, std::move(dev), start);
+    step_and_check(session, start);
+    const HapticHandStats h = session.stats().hands[static_cast<size_t>(Hand::Right)];
+    // Sample-and-hold at 2 ms per sample: each is read twice and counted once.
+    EXPECT_EQ(h.samples, 2u) << "seq 1 and seq 5 reach the physics";
+    EXPECT_EQ(h.samples_outside_workspace, 2u);
+    EXPECT_EQ(h.samples_non_finite, 1u);
+    EXPECT_EQ(h.samples_clamped, 1u);
+    ToolPose pose;
+    ASSERT_TRUE(session.newest_pose(Hand::Right, pose));
+    EXPECT_EQ(pose.pos, Vec3(0.5, 0, -0.3));
+    EXPECT_EQ(pose.pedal, kMaxPedal);
+  }
+  // The recording holds only what passed, clamped as the physics got it.
+  ASSERT_EQ(recorder.size(), 2u);
+  EXPECT_EQ(recorder.rejected(), 3u);
+  EXPECT_EQ(recorder.samples()[1].pedal, kMaxPedal);
+}
+
+TEST(HapticSessionBounds, ScriptedTrackOutOfBoundsIsDroppedEveryTick) {
+  // Interpolated between a good pose and 1.2e19 mm: every tick after the first is outside.
+  HandTrack h = faulty_track();
+  h.track.resize(2);
+  HapticSession session(quiet_config());
+  const int64_t start = 1'000 * kMs;
+  attach_at_the_wall(session, std::make_unique<ScriptedDevice>(h), start);
+  step_and_check(session, start);
+  const HapticHandStats s = session.stats().hands[static_cast<size_t>(Hand::Right)];
+  EXPECT_EQ(s.samples, 1u);
+  EXPECT_EQ(s.samples_outside_workspace, 9u) << "a new sample each tick, each counted";
+  EXPECT_EQ(s.samples_non_finite, 0u);
+}
+
+// A UDP bridge on loopback, packets into the wall. The device's receive time of the last packet
+// comes back with the sample; ticks then run at chosen instants after it.
+struct UdpHand {
+  UdpBridgePeer peer;
+  UdpBridgeDevice* device = nullptr;
+  uint32_t seq = 0;
+  explicit UdpHand(HapticSession& session,
+                   double silence_ms = UdpBridgeConfig{}.silence_timeout_ms) {
+    UdpBridgeConfig c;
+    c.bind_host = "127.0.0.1";
+    c.peer_host = "127.0.0.1";
+    c.peer_port = peer.local_port();
+    c.silence_timeout_ms = silence_ms;
+    c.max_age_ms = 1000;
+    auto dev = std::make_unique<UdpBridgeDevice>(c);
+    device = dev.get();
+    peer.set_device("127.0.0.1", device->local_port());
+    device->start(now_ns());
+    session.attach(Hand::Right, std::move(dev));
+  }
+  udp_protocol::PoseMessage pose(float x, float y, float z) {
+    udp_protocol::PoseMessage m;
+    m.seq = ++seq;
+    m.sender_time_us = steady_time_us();
+    m.pos_mm = {x, y, z};
+    return m;
+  }
+  // Sends a pose until the device shows it while live (a read later than the silence timeout
+  // reads as silence: a slow machine just takes another try) and returns its receive time.
+  int64_t deliver(float z) {
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+      peer.send(pose(0, 0, z));
+      DeviceSample s;
+      const int64_t give_up = now_ns() + 20 * kMs;
+      while (now_ns() < give_up) {
+        if (device->read(now_ns(), s) && s.seq == seq) return s.t_ns;
+      }
+    }
+    return -1;
+  }
+};
+
+// Issue 18: when packets stop, the tool freezes and the force goes to zero within 5 ms. Ticks run
+// at the loop's period from the last packet's receive time, at several phases of the tick
+// against the packet; every tick up to the silence timeout still pushes (so the zero is the
+// silence's doing), and the first zero comes no later than 5 ms after the last packet.
+TEST(HapticSessionSilence, ForceIsZeroAndToolFrozenWithin5msOfTheLastPacket) {
+  HapticSession session(quiet_config());
+  UdpHand udp(session);
+  wall_model(session.model_slot(), 1);
+  session.publish_model();
+  const int64_t period = quiet_config().loop.period_ns;
+  const int64_t timeout_ns = std::llround(UdpBridgeConfig{}.silence_timeout_ms * 1e6);
+  int64_t k = 0;
+  for (const int64_t phase : {int64_t{0}, period / 4, period / 2, period - 1}) {
+    SCOPED_TRACE("tick phase " + std::to_string(phase) + " ns");
+    const float z = -0.2f - 0.01f * static_cast<float>(k % 7);
+    const int64_t last = udp.deliver(z);
+    ASSERT_GT(last, 0) << "no packet read back within the silence timeout in 1000 tries";
+    int64_t first_zero = -1;
+    for (int64_t t = last + phase; t <= last + 20 * kMs; t += period) {
+      session.step(tick_at(k++, t));
+      const Vec3 f = session.last_force(Hand::Right);
+      ToolPose pose;
+      ASSERT_TRUE(session.newest_pose(Hand::Right, pose));
+      EXPECT_FLOAT_EQ(static_cast<float>(pose.pos.z()), z) << "frozen at the last pose";
+      if (t - last <= timeout_ns) {
+        EXPECT_GT(f.z(), 1.0) << "live at " << (t - last) << " ns: the wall pushes";
+      } else if (first_zero < 0) {
+        first_zero = t - last;
+      }
+      if (first_zero >= 0) {
+        EXPECT_EQ(f, Vec3::Zero()) << "at " << (t - last) << " ns";
+      }
+    }
+    ASSERT_GE(first_zero, 0);
+    EXPECT_LE(first_zero, 5 * kMs) << "silence to zero force";
+  }
+  const HapticHandStats h = session.stats().hands[static_cast<size_t>(Hand::Right)];
+  EXPECT_GT(h.zero_force_ticks, 0u);
+  EXPECT_EQ(h.samples, 4u);
+  udp.device->stop();
+}
+
+TEST(HapticSessionBounds, UdpPacketsOutOfBoundsStopAtTheBridge) {
+  HapticSession session(quiet_config());
+  UdpHand udp(session, /*silence_ms=*/60'000);
+  wall_model(session.model_slot(), 1);
+  session.publish_model();
+  ASSERT_GT(udp.deliver(-0.2f), 0);
+  udp.peer.send(udp.pose(1e19f, 0, 0));
+  udp.peer.send(udp.pose(std::numeric_limits<float>::quiet_NaN(), 0, 0));
+  ASSERT_TRUE(wait_for([&] {
+    const DeviceCounters c = udp.device->counters();
+    return c.out_of_workspace == 1 && c.non_finite == 1;
+  }));
+  step_and_check(session, now_ns());
+  const HapticHandStats h = session.stats().hands[static_cast<size_t>(Hand::Right)];
+  EXPECT_EQ(h.samples, 1u);
+  EXPECT_EQ(h.samples_outside_workspace + h.samples_non_finite, 0u) << "the bridge dropped them";
+  EXPECT_EQ(h.counters.dropped(), 2u);
+  udp.device->stop();
+}
+
+TEST(HapticSession, StepIsRefusedWhileTheThreadRuns) {
+  HapticSession session(quiet_config());
+  session.attach(Hand::Right, std::make_unique<HandDevice>());
+  session.start();
+  EXPECT_THROW(session.step(tick_at(0, now_ns())), std::logic_error);
+  session.stop();
 }
 
 }  // namespace
