@@ -19,6 +19,7 @@
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/haptics/realtime_run.hpp"
 #include "procedures/scene/run.hpp"
+#include "procedures/scene/scene_inputs.hpp"
 
 namespace phaco::cli {
 
@@ -69,6 +70,8 @@ int validate(const std::vector<std::string>& raw) {
   for (const auto& file : a.positional) {
     try {
       const Scenario s = load_scenario(file);
+      // The drill file, the difficulty and the eye parameters, as `run` reads them before meshes.
+      check_scene_inputs(s);
       std::printf("%s: ok (%s, %zu hand(s), %.3f s, %llu frames)\n", file.c_str(),
                   std::string(to_string(s.drill)).c_str(), s.hands.size(), s.duration_s,
                   static_cast<unsigned long long>(s.frame_count()));

@@ -38,7 +38,9 @@ usage:
       --stall-at/--stall-ms make the simulation hang once, to show the force stays continuous.
       --record stores the scenario with the track the device produced (docs/records.md).
   phaco validate FILE...
-      Check scenario files; every problem is named by file, JSON path and what was expected.
+      Check scenario files and what they use (the drill file, its difficulty level, the eye
+      parameters and overrides, each within its range; docs/scenario_format.md); every problem is
+      named by file, JSON path and what was expected. A file validate accepts runs to its end.
   phaco mesh --level L --out DIR [--layout curvilinear|isotropic] [--no-tets] [--params FILE]
       Generate the standard eye's meshes at resolution level L (0..8, default eye level 3:
       about 8k capsule vertices, 50k lens tets) as OBJ and TetGen .node/.ele files.

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "engine/core/error.hpp"
+#include "engine/io/bounds.hpp"
 #include "engine/io/json_reader.hpp"
 
 namespace phaco {
@@ -149,10 +150,12 @@ class DrillParser {
       if (name.empty()) r_.fail(path, "expected a metric name, got an empty key");
       r_.expect_object(band, path, {"min", "max"});
       TargetBand t;
-      if (const json* x = JsonReader::find(band, "min"))
-        t.min = r_.number(*x, path_key(path, "min"));
-      if (const json* x = JsonReader::find(band, "max"))
-        t.max = r_.number(*x, path_key(path, "max"));
+      if (const json* x = JsonReader::find(band, "min")) {
+        t.min = r_.number_in(*x, path_key(path, "min"), -kMaxMetricMagnitude, kMaxMetricMagnitude);
+      }
+      if (const json* x = JsonReader::find(band, "max")) {
+        t.max = r_.number_in(*x, path_key(path, "max"), -kMaxMetricMagnitude, kMaxMetricMagnitude);
+      }
       if (!t.min && !t.max) r_.fail(path, "expected \"min\" and/or \"max\", got neither");
       if (t.min && t.max && *t.min > *t.max) {
         r_.fail(path, "min " + format_number(*t.min) + " is above max " + format_number(*t.max));
@@ -183,7 +186,7 @@ class DrillParser {
                               path_key(path, "weight"), 0, kTotalPoints);
       if (!(t.weight > 0)) r_.fail(path_key(path, "weight"), "expected points > 0, got 0");
       t.falloff = r_.number_in(r_.require(a[i], path, "falloff", "a distance >= 0"),
-                               path_key(path, "falloff"), 0, 1e9);
+                               path_key(path, "falloff"), 0, kMaxMetricMagnitude);
       total += t.weight;
       d.scoring.push_back(std::move(t));
     }
@@ -193,9 +196,7 @@ class DrillParser {
   }
 
   Vec3 point(const json& v, const std::string& path) const {
-    std::array<double, 3> p{};
-    r_.fixed_numbers(v, path, p, "[x, y, z]");
-    return {p[0], p[1], p[2]};
+    return io::read_workspace_point(r_, v, path);
   }
 
   Guidance::Site site(const json& v, const std::string& path) const {

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "engine/core/error.hpp"
+#include "engine/io/bounds.hpp"
 #include "engine/io/json_reader.hpp"
 
 namespace phaco {
@@ -34,8 +35,6 @@ constexpr std::array<std::string_view, 5> kMeshBodies{"cornea", "capsule", "iris
                                                       "lens_surface"};
 
 constexpr int kMaxLevel = 8;
-constexpr double kMaxDt = 0.1;           // s; coarser steps cannot resolve tool contact
-constexpr double kMaxDuration = 3600.0;  // s
 constexpr double kMaxGrip = 1.0;
 constexpr double kMaxPedal = 3.0;
 constexpr double kMinQuatLength = 1e-9;
@@ -68,10 +67,9 @@ class ScenarioParser {
     if (!root.is_object()) {
       r_.fail("$", "expected a JSON object at the top level, got " + io::describe_value(root));
     }
-    r_.expect_object(
-        root, "$",
-        {"name", "description", "drill", "drill_file", "difficulty", "eye", "methods", "dt_s", "seed",
-         "duration_s", "hands"});
+    r_.expect_object(root, "$",
+                     {"name", "description", "drill", "drill_file", "difficulty", "eye", "methods",
+                      "dt_s", "seed", "duration_s", "hands"});
     Scenario s;
     s.source = r_.source();
     if (const json* v = JsonReader::find(root, "name")) s.name = r_.string(*v, "name");
@@ -89,17 +87,17 @@ class ScenarioParser {
 
     if (const json* v = JsonReader::find(root, "dt_s")) {
       s.dt_s = r_.number(*v, "dt_s");
-      if (!(s.dt_s > 0 && s.dt_s <= kMaxDt)) {
-        r_.fail("dt_s", "expected a time step > 0 and <= " + format_number(kMaxDt) + " s, got " +
-                            format_number(s.dt_s));
+      if (!(s.dt_s >= kMinStepS && s.dt_s <= kMaxStepS)) {
+        r_.fail("dt_s", "expected a time step in " + format_number(kMinStepS) + ".." +
+                            format_number(kMaxStepS) + " s, got " + format_number(s.dt_s));
       }
     }
     if (const json* v = JsonReader::find(root, "seed")) s.seed = r_.unsigned_integer(*v, "seed");
 
     const std::string duration_expected =
-        "a duration > 0 and <= " + format_number(kMaxDuration) + " s";
+        "a duration > 0 and <= " + format_number(kMaxDurationS) + " s";
     s.duration_s = r_.number(r_.require(root, "$", "duration_s", duration_expected), "duration_s");
-    if (!(s.duration_s > 0 && s.duration_s <= kMaxDuration)) {
+    if (!(s.duration_s > 0 && s.duration_s <= kMaxDurationS)) {
       r_.fail("duration_s",
               "expected " + duration_expected + ", got " + format_number(s.duration_s));
     }
@@ -137,22 +135,26 @@ class ScenarioParser {
   // "body.setting": "choice" — which method a body uses; names are checked by the scene builder.
   std::map<std::string, std::string> methods(const json& v, const std::string& path) const {
     if (!v.is_object()) {
-      r_.fail(path, "expected an object of \"body.setting\": \"choice\" (e.g. \"capsule.integrator\": "
-                    "\"implicit_euler\"), got " + io::describe_value(v));
+      r_.fail(path,
+              "expected an object of \"body.setting\": \"choice\" (e.g. \"capsule.integrator\": "
+              "\"implicit_euler\"), got " +
+                  io::describe_value(v));
     }
     std::map<std::string, std::string> out;
     for (const auto& [key, value] : v.items()) {
       const std::string kpath = path_key(path, key);
       if (!is_override_key(key)) {
-        r_.fail(kpath, "method key must have the form 'body.setting' (e.g. 'capsule.integrator'), got '" +
-                           key + "'");
+        r_.fail(kpath,
+                "method key must have the form 'body.setting' (e.g. 'capsule.integrator'), got '" +
+                    key + "'");
       }
       out[key] = r_.string(value, kpath);
     }
     return out;
   }
 
-  // "difficulty": "hard" (a level of the drill file) or {"level"?: "hard", "patient_age_years": 85, ...}.
+  // "difficulty": "hard" (a level of the drill file) or {"level"?: "hard", "patient_age_years": 85,
+  // ...}.
   void difficulty(const json& v, Scenario& s) const {
     if (v.is_string()) {
       s.difficulty = r_.string(v, "difficulty");
@@ -275,15 +277,17 @@ class ScenarioParser {
     const std::string time_path = path_key(path, "t");
     out.t = r_.number(r_.require(v, path, "t", "a time in s >= 0"), time_path);
     if (out.t < 0) r_.fail(time_path, "expected a time >= 0 s, got " + format_number(out.t));
+    if (out.t > kMaxDurationS) {
+      r_.fail(time_path, "expected a time <= " + format_number(kMaxDurationS) +
+                             " s (the longest scenario), got " + format_number(out.t));
+    }
     if (previous != nullptr && !(out.t > previous->t)) {
       r_.fail(time_path, "track not sorted in time: expected t > " + format_number(previous->t) +
                              ", got " + format_number(out.t));
     }
 
-    std::array<double, 3> p{};
-    r_.fixed_numbers(r_.require(v, path, "pos", "[x, y, z] in mm"), path_key(path, "pos"), p,
-                     "[x, y, z]");
-    out.pos = Vec3(p[0], p[1], p[2]);
+    out.pos = io::read_workspace_point(r_, r_.require(v, path, "pos", "[x, y, z] in mm"),
+                                       path_key(path, "pos"));
 
     if (const json* q = JsonReader::find(v, "quat")) {
       const std::string qpath = path_key(path, "quat");
@@ -318,7 +322,8 @@ DifficultySettings DifficultySettings::overlaid(const DifficultySettings& over) 
   DifficultySettings out = *this;
   if (over.patient_age_years) out.patient_age_years = over.patient_age_years;
   if (over.anterior_bowing_kpa) out.anterior_bowing_kpa = over.anterior_bowing_kpa;
-  if (over.anterior_chamber_depth_mm) out.anterior_chamber_depth_mm = over.anterior_chamber_depth_mm;
+  if (over.anterior_chamber_depth_mm)
+    out.anterior_chamber_depth_mm = over.anterior_chamber_depth_mm;
   if (over.nucleus_hardness) out.nucleus_hardness = over.nucleus_hardness;
   return out;
 }
@@ -338,16 +343,18 @@ DifficultySettings read_difficulty_settings(const io::JsonReader& r, const json&
       {"anterior_chamber_depth_mm", 1.5, 4.5, &DifficultySettings::anterior_chamber_depth_mm},
       {"nucleus_hardness", 0.05, 1, &DifficultySettings::nucleus_hardness}};
   if (!v.is_object()) {
-    r.fail(path, "expected an object of difficulty settings (patient_age_years, "
-                 "anterior_bowing_kpa, anterior_chamber_depth_mm, nucleus_hardness), got " +
-                     io::describe_value(v));
+    r.fail(path,
+           "expected an object of difficulty settings (patient_age_years, "
+           "anterior_bowing_kpa, anterior_chamber_depth_mm, nucleus_hardness), got " +
+               io::describe_value(v));
   }
   for (const auto& [key, unused] : v.items()) {
     bool known = std::find(extra.begin(), extra.end(), key) != extra.end();
     for (const Field& f : kFields) known = known || f.name == key;
     if (!known) {
       std::string names;
-      for (const Field& f : kFields) names += std::string(names.empty() ? "" : ", ") + std::string(f.name);
+      for (const Field& f : kFields)
+        names += std::string(names.empty() ? "" : ", ") + std::string(f.name);
       for (std::string_view e : extra) names += ", " + std::string(e);
       r.fail(path_key(path, key), "unknown difficulty setting; expected one of: " + names);
     }
@@ -392,8 +399,8 @@ bool operator==(const TrackSample& a, const TrackSample& b) {
 bool operator==(const Scenario& a, const Scenario& b) {
   return a.name == b.name && a.description == b.description && a.drill == b.drill &&
          a.eye == b.eye && a.drill_file == b.drill_file && a.difficulty == b.difficulty &&
-         a.difficulty_settings == b.difficulty_settings && a.methods == b.methods && a.dt_s == b.dt_s && a.seed == b.seed && a.duration_s == b.duration_s &&
-         a.hands == b.hands;
+         a.difficulty_settings == b.difficulty_settings && a.methods == b.methods &&
+         a.dt_s == b.dt_s && a.seed == b.seed && a.duration_s == b.duration_s && a.hands == b.hands;
 }
 
 uint64_t Scenario::frame_count() const {

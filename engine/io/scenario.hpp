@@ -1,9 +1,9 @@
 #pragma once
 // Scenario files (DESIGN.md §7): which drill, which eye, the fixed step, the seed, the duration
 // and, per hand, a tool with a timed track. The same format drives tests, demos, the perf harness
-// and recorded sessions, so it is validated strictly: unknown fields, unsorted tracks and
-// non-finite numbers are errors with a message "FILE: JSON.PATH: what was expected, what was
-// found".
+// and recorded sessions, so it is validated strictly: unknown fields, unsorted tracks, non-finite
+// numbers and numbers outside their bounds (engine/io/bounds.hpp, docs/scenario_format.md) are
+// errors with a message "FILE: JSON.PATH: what was expected, what was found".
 #include <cstdint>
 #include <filesystem>
 #include <initializer_list>

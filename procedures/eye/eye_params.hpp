@@ -21,15 +21,17 @@ struct EyeParams {
 const std::vector<std::string_view>& required_eye_keys();
 
 // Throws InputError naming the file and the JSON path (e.g. "/lens/nucleus_fraction") on a
-// missing file, invalid JSON, a missing key, or a value that is not a finite positive number.
+// missing file, invalid JSON, a missing key, a value that is not a finite positive number, or one
+// outside its physical range (eye_param_ranges.hpp).
 EyeParams load_eye_params(const std::filesystem::path& file);
 
 // data_dir() / "eye" / "standard_eye.json".
 EyeParams default_eye_params();
 
-// Throws InputError "unknown eye parameter 'key' (known: ...)", or on a non-finite or non-positive
-// value. Geometric consistency (e.g. capsule radius inside the lens) is checked when meshes are
-// made.
+// Throws InputError "unknown eye parameter 'key' (known: ...)", or "expected a number in lo..hi
+// (the physical range of key), got v" for a value outside the key's range (eye_param_ranges.hpp)
+// or one that is not finite and positive. Geometric consistency (e.g. capsule radius inside the
+// lens) is checked when meshes are made.
 void apply_override(EyeParams& params, const std::string& key, double value);
 
 // The data directory: env PHACO_DATA_DIR if set, else the source tree's data/ (compile time).

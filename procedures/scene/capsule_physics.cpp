@@ -93,7 +93,7 @@ void add_capsule_physics(Scene& scene) {
   material.pretension = pretension == "cotangent" ? springs::Pretension::Cotangent
                                                   : springs::Pretension::UniformPrestretch;
   cs.material = material;
-  sp.springs = springs::build_springs(particles, triangles, material);
+  sp.springs = springs::build_springs(particles, triangles, material, &sp.clamped_pretension);
   sp.blocks = springs::plan_blocks(sp.springs, particles.slots.size());
   sp.glue = Glue{particles.x, particles.y, particles.z};
   sp.graph = springs::build_spring_graph(sp.springs, particles.slots.size());
@@ -240,6 +240,7 @@ nlohmann::json capsule_physics_summary(const Scene& scene) {
           {"spring_law", cs->dynamics.law == SpringLaw::Quadratic ? "quadratic" : "linear"},
           {"active_set", cs->use_active_set},
           {"springs", sp.springs.slots.live_count()},
+          {"clamped_pretension", sp.clamped_pretension},
           {"frames_stepped", stats.frames_stepped},
           {"active_particles_mean", mean_active},
           {"active_particles_max", stats.active_particle_max},

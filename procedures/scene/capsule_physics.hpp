@@ -58,6 +58,9 @@ struct CapsuleSprings {
   SpringGraph graph;
   Glue glue;             // per particle: the point on the lens its glue spring pulls to, mm
   uint64_t version = 0;  // +1 whenever springs, blocks or graph change after the build
+  // Edges built with the uniform pre-stretch because their cotangent tension needs a rest length
+  // below half the edge (systems/springs build_springs; a high pre-stretch on a coarse mesh).
+  uint32_t clamped_pretension = 0;
 };
 
 // capsule.solver.

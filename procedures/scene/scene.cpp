@@ -10,8 +10,10 @@
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
 #include "engine/core/state_hash.hpp"
+#include "engine/io/json_reader.hpp"
 #include "engine/io/mesh_obj.hpp"
 #include "procedures/eye/difficulty.hpp"
+#include "procedures/eye/eye_geometry.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
@@ -21,6 +23,7 @@
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
+#include "procedures/scene/scene_inputs.hpp"
 #include "procedures/scene/tool_ports.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
 
@@ -47,8 +50,15 @@ eye::EyeParams load_params(const Scenario& s, const DifficultySettings& difficul
     try {
       eye::apply_override(params, key, value);
     } catch (const InputError& e) {
-      throw InputError(s.source + ": eye.overrides." + key + ": " + e.what());
+      throw InputError(s.source + ": " + io::path_key("eye.overrides", key) + ": " + e.what());
     }
+  }
+  // Each value in its range can still make an impossible eye (a capsule wider than the lens):
+  // caught here, before any mesh, so `phaco validate` sees it too.
+  try {
+    eye::eye_geometry(params);
+  } catch (const InputError& e) {
+    throw InputError(s.source + ": eye: " + e.what());
   }
   return params;
 }
@@ -293,21 +303,32 @@ std::optional<Entity> Scene::body(BodyPart part) const {
   return std::nullopt;
 }
 
+SceneInputs check_scene_inputs(const Scenario& scenario) {
+  SceneInputs in;
+  in.drill = load_drill_for(scenario);
+  check_tools(scenario, in.drill);
+  in.difficulty = resolve_difficulty(in.drill, scenario.difficulty, scenario.difficulty_settings,
+                                     scenario.source);
+  in.params = load_params(scenario, in.difficulty);
+  std::vector<BodyPart> parts;
+  for (const std::string& name : in.drill.bodies) parts.push_back(body_part(name));
+  check_methods(scenario, parts);
+  return in;
+}
+
 std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions& options) {
   auto scene = std::make_unique<Scene>();
   scene->scenario = scenario;
-  scene->drill = load_drill_for(scenario);
-  check_tools(scenario, scene->drill);
-  scene->difficulty = resolve_difficulty(scene->drill, scenario.difficulty,
-                                         scenario.difficulty_settings, scenario.source);
-  scene->params = load_params(scenario, scene->difficulty);
+  SceneInputs inputs = check_scene_inputs(scenario);
+  scene->drill = std::move(inputs.drill);
+  scene->difficulty = inputs.difficulty;
+  scene->params = std::move(inputs.params);
   scene->resolution = eye::resolution_for_level(scenario.eye.level);
   scene->commands = CommandQueues(options.threads);
   scene->haptics = options.haptics;
 
   std::vector<BodyPart> parts;
   for (const std::string& name : scene->drill.bodies) parts.push_back(body_part(name));
-  check_methods(scenario, parts);
   const bool need_tets = std::find(parts.begin(), parts.end(), BodyPart::Lens) != parts.end();
   const auto layout = scenario.eye.capsule_layout == "isotropic" ? eye::CapsuleLayout::Isotropic
                                                                  : eye::CapsuleLayout::Curvilinear;

@@ -17,7 +17,9 @@ struct EdgeRecord {
   double cot;   // half the sum of the cotangents of the angles opposite the edge
 };
 
-Vec3 position(const Particles& p, uint32_t v) { return {p.x[v], p.y[v], p.z[v]}; }
+Vec3 position(const Particles& p, uint32_t v) {
+  return {p.x[v], p.y[v], p.z[v]};
+}
 
 double triangle_area(const Particles& p, uint32_t a, uint32_t b, uint32_t c) {
   const Vec3 pa(p.x[a], p.y[a], p.z[a]), pb(p.x[b], p.y[b], p.z[b]), pc(p.x[c], p.y[c], p.z[c]);
@@ -26,11 +28,13 @@ double triangle_area(const Particles& p, uint32_t a, uint32_t b, uint32_t c) {
 
 }  // namespace
 
-SpringConstants edge_spring_constants(const SpringMaterial& m, double l, double area_sum, double half_cot_sum) {
+SpringConstants edge_spring_constants(const SpringMaterial& m, double l, double area_sum,
+                                      double half_cot_sum) {
   static const double equilateral = std::sqrt(3.0) / 2.0;
   SpringConstants out;
-  double k = m.sheet_modulus_mn_mm *
-             (m.weighting == StiffnessWeighting::AreaWeighted && l > 0 ? area_sum / (l * l) : equilateral);
+  double k =
+      m.sheet_modulus_mn_mm *
+      (m.weighting == StiffnessWeighting::AreaWeighted && l > 0 ? area_sum / (l * l) : equilateral);
   if (m.law == SpringLaw::Quadratic) k /= m.quadratic_reference_mm;
   double rest = (1.0 - m.prestretch) * l;
   if (m.pretension == Pretension::Cotangent && k > 0) {
@@ -49,8 +53,10 @@ SpringConstants edge_spring_constants(const SpringMaterial& m, double l, double 
   return out;
 }
 
-Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& m) {
-  if (!(m.prestretch >= 0.0 && m.prestretch < 1.0)) throw std::invalid_argument("prestretch must be in [0, 1)");
+Springs build_springs(const Particles& particles, const Triangles& triangles,
+                      const SpringMaterial& m, uint32_t* clamped_pretension) {
+  if (!(m.prestretch >= 0.0 && m.prestretch < 1.0))
+    throw std::invalid_argument("prestretch must be in [0, 1)");
   std::vector<EdgeRecord> edges;
   edges.reserve(triangles.slots.size() * 3);
   for (uint32_t t = 0; t < triangles.slots.size(); ++t) {
@@ -59,14 +65,16 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
     const double area = triangle_area(particles, v[0], v[1], v[2]);
     for (int k = 0; k < 3; ++k) {
       const uint32_t a = v[k], b = v[(k + 1) % 3], o = v[(k + 2) % 3];
-      const Vec3 u = position(particles, a) - position(particles, o), w = position(particles, b) - position(particles, o);
+      const Vec3 u = position(particles, a) - position(particles, o),
+                 w = position(particles, b) - position(particles, o);
       const double cross = u.cross(w).norm();
       const double half_cot = cross > 0 ? 0.5 * u.dot(w) / cross : 0.0;
       edges.push_back({std::min(a, b), std::max(a, b), area, half_cot});
     }
   }
-  std::sort(edges.begin(), edges.end(),
-            [](const EdgeRecord& x, const EdgeRecord& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+  std::sort(edges.begin(), edges.end(), [](const EdgeRecord& x, const EdgeRecord& y) {
+    return x.i != y.i ? x.i < y.i : x.j < y.j;
+  });
 
   Springs s;
   for (size_t e = 0; e < edges.size();) {
@@ -81,10 +89,8 @@ Springs build_springs(const Particles& particles, const Triangles& triangles, co
                  dz = particles.z[b] - particles.z[a];
     const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
     const SpringConstants sc = edge_spring_constants(m, l, area, cot);
-    if (sc.pretension_clamped) {
-      throw std::invalid_argument("cotangent pre-tension needs a rest length below half of edge (" +
-                                  std::to_string(a) + ", " + std::to_string(b) + "): mesh too badly shaped");
-    }
+    // As the cut's re-springing does: such an edge keeps the uniform pre-stretch, and is counted.
+    if (sc.pretension_clamped && clamped_pretension != nullptr) ++*clamped_pretension;
     const double k = sc.stiffness, rest = sc.rest_length;
     const uint32_t idx = table_add(s);
     s.i[idx] = a;
@@ -103,8 +109,8 @@ SpringGraph build_spring_graph(const Springs& springs, uint32_t particle_count) 
   for (uint32_t e = 0; e < ns; ++e) {
     if (!springs.slots.alive(e)) continue;
     if (springs.i[e] >= particle_count || springs.j[e] >= particle_count)
-      throw std::invalid_argument("build_spring_graph: spring " + std::to_string(e) + " names a particle beyond " +
-                                  std::to_string(particle_count));
+      throw std::invalid_argument("build_spring_graph: spring " + std::to_string(e) +
+                                  " names a particle beyond " + std::to_string(particle_count));
     ++g.row_size[springs.i[e]];
     ++g.row_size[springs.j[e]];
   }
@@ -226,19 +232,22 @@ SpringBlocks plan_blocks(const Springs& s, uint32_t particle_count, uint32_t tar
   uint32_t max_span = 0;
   for (uint32_t e = 0; e < s.slots.size(); ++e) {
     if (s.j[e] < s.i[e]) throw std::invalid_argument("plan_blocks: springs must have i < j");
-    if (e > 0 && s.i[e] < s.i[e - 1]) throw std::invalid_argument("plan_blocks: springs must be sorted by i");
+    if (e > 0 && s.i[e] < s.i[e - 1])
+      throw std::invalid_argument("plan_blocks: springs must be sorted by i");
     max_span = std::max(max_span, s.j[e] - s.i[e]);
   }
   const uint32_t n = std::max<uint32_t>(particle_count, 1);
-  const uint32_t by_target = (n + std::max<uint32_t>(target_blocks, 1) - 1) / std::max<uint32_t>(target_blocks, 1);
+  const uint32_t by_target =
+      (n + std::max<uint32_t>(target_blocks, 1) - 1) / std::max<uint32_t>(target_blocks, 1);
   const uint32_t block_size = std::max(by_target, max_span + 1);
   SpringBlocks b;
   for (uint32_t start = 0; start < n; start += block_size) b.particle_begin.push_back(start);
   b.particle_begin.push_back(n);
   for (uint32_t k = 0; k < b.particle_begin.size(); ++k) {
     const auto it = std::lower_bound(s.i.begin(), s.i.end(), b.particle_begin[k]);
-    b.spring_begin.push_back(k + 1 == b.particle_begin.size() ? s.slots.size()
-                                                               : static_cast<uint32_t>(it - s.i.begin()));
+    b.spring_begin.push_back(k + 1 == b.particle_begin.size()
+                                 ? s.slots.size()
+                                 : static_cast<uint32_t>(it - s.i.begin()));
   }
   return b;
 }
@@ -296,7 +305,8 @@ void spring_range(const Springs& s, uint32_t begin, uint32_t end, const Particle
   }
 }
 
-void spring_range(const Springs& s, uint32_t begin, uint32_t end, SpringLaw law, const Particles& p, Forces& f) {
+void spring_range(const Springs& s, uint32_t begin, uint32_t end, SpringLaw law, const Particles& p,
+                  Forces& f) {
   if (law == SpringLaw::Linear) {
     spring_range<SpringLaw::Linear>(s, begin, end, p, f);
   } else {
@@ -306,7 +316,8 @@ void spring_range(const Springs& s, uint32_t begin, uint32_t end, SpringLaw law,
 
 }  // namespace
 
-void add_spring_forces(const Springs& s, const SpringBlocks& blocks, SpringLaw law, const Particles& p, Forces& f) {
+void add_spring_forces(const Springs& s, const SpringBlocks& blocks, SpringLaw law,
+                       const Particles& p, Forces& f) {
   const uint32_t nb = blocks.count();
   if (nb <= 2) {
     spring_range(s, 0, s.slots.size(), law, p, f);

@@ -14,7 +14,8 @@
 //    not equilateral the resulting tension is not isotropic: on the capsule's rings and spokes the
 //    hoop tension is 12 % above the radial one, and the analytic membrane test misses by 17.7 %
 //    (docs/membrane_accuracy.md).
-//  - Cotangent: rest lengths chosen so that spring e carries the tension t_e = T0·(cot α + cot β)/2·l_e
+//  - Cotangent: rest lengths chosen so that spring e carries the tension t_e = T0·(cot α + cot
+//  β)/2·l_e
 //    (α, β the angles opposite e): the discrete form of an isotropic membrane stress T0·I, in
 //    equilibrium as built on any triangulation. T0 = 1.5·prestretch·c, the equibiaxial tension of
 //    a sheet of modulus c and Poisson ratio 1/3 (the triangular lattice's) stretched by prestretch.
@@ -55,13 +56,16 @@ struct SpringConstants {
   double rest_length = 0.0;
   bool pretension_clamped = false;
 };
-SpringConstants edge_spring_constants(const SpringMaterial& material, double length, double area_sum,
-                                      double half_cot_sum);
+SpringConstants edge_spring_constants(const SpringMaterial& material, double length,
+                                      double area_sum, double half_cot_sum);
 
 // One spring per edge, sorted by (i, j); stiffness and rest length from the current positions.
-// Throws std::invalid_argument for a prestretch outside [0, 1) or a cotangent tension that would
-// need a rest length below half the edge (an obtuse, badly shaped mesh).
-Springs build_springs(const Particles& particles, const Triangles& triangles, const SpringMaterial& material);
+// An edge whose cotangent tension would need a rest length below half the edge (an obtuse,
+// badly shaped triangle, or a high pre-stretch on a coarse mesh: a bowed capsule at level 0)
+// gets the uniform pre-stretch instead (edge_spring_constants), counted in *clamped_pretension
+// when given. Throws std::invalid_argument for a prestretch outside [0, 1).
+Springs build_springs(const Particles& particles, const Triangles& triangles,
+                      const SpringMaterial& material, uint32_t* clamped_pretension = nullptr);
 
 // Both directions of every alive spring, rows sorted by neighbour (independent of the spring
 // table's order), each row with room for kGraphRowSlack more entries. Throws
@@ -83,7 +87,8 @@ std::vector<std::pair<uint32_t, uint32_t>> graph_row(const SpringGraph& graph, u
 
 // Partition for the parallel force pass; `target_blocks` is a mesh-size choice (e.g. 64), never
 // the thread count. Falls back to fewer (at worst one) blocks when springs span far in index.
-SpringBlocks plan_blocks(const Springs& springs, uint32_t particle_count, uint32_t target_blocks = 64);
+SpringBlocks plan_blocks(const Springs& springs, uint32_t particle_count,
+                         uint32_t target_blocks = 64);
 
 // Adds every spring's force to both ends: f_i += F·x̂, f_j −= F·x̂ with x̂ from i to j and
 // F = k·(l − l0) (linear) or k·(l − l0)·|l − l0| (quadratic). Parallel over even then odd blocks,

@@ -69,6 +69,42 @@ TEST(Cli, ValidateNamesFileAndField) {
   fs::remove_all(dir);
 }
 
+// Issue 18 item 1: validate checks what run reads before its meshes (the drill file, the tools it
+// allows, the eye overrides in their ranges, the eye's geometry) and the workspace, so a file it
+// accepts is one run does not refuse; each refusal names the file and the field (exit 2).
+TEST(Cli, ValidateChecksWhatRunReadsAndTheBounds) {
+  const fs::path dir = temp_dir("validate_bounds");
+  auto with = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string text = kSmall;
+    text.replace(text.find(from), from.size(), to);
+    return write_text(dir, name, text);
+  };
+  const struct {
+    fs::path file;
+    const char* message;
+  } cases[] = {
+      {with("far.json", "[0, 0, 2]", "[0, 0, 1e300]"),
+       "far.json: hands.right.track[1].pos[2]: expected a coordinate in -50..50 mm"},
+      {with("stiff.json", "\"level\": 0 }",
+            "\"level\": 0, \"overrides\": { \"capsule.youngs_modulus_kpa\": 1e9 } }"),
+       "stiff.json: eye.overrides[\"capsule.youngs_modulus_kpa\"]: expected a number in "
+       "100..20000"},
+      {with("wide.json", "\"level\": 0 }",
+            "\"level\": 0, \"overrides\": { \"capsule.radius_mm\": 5.5 } }"),
+       "wide.json: eye: inconsistent eye parameters: capsule.radius_mm"},
+      {with("tool.json", "\"cystotome\"", "\"phaco_probe\""),
+       "tool.json: hands.right.tool: the capsulorhexis drill"},
+  };
+  for (const auto& c : cases) {
+    const Result r = phaco("validate " + c.file.string());
+    EXPECT_EQ(r.code, 2) << c.file << ": " << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+  }
+  const Result edge = phaco("validate " + with("edge.json", "[0, 0, 2]", "[0, 0, 50]").string());
+  EXPECT_EQ(edge.code, 0) << edge.output;
+  fs::remove_all(dir);
+}
+
 TEST(Cli, RunWritesReportAndIsThreadIndependent) {
   const fs::path dir = temp_dir("run");
   const fs::path scen = write_text(dir, "small.json", kSmall);

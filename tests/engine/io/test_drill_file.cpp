@@ -8,6 +8,7 @@
 #include <string>
 
 #include "engine/core/error.hpp"
+#include "engine/io/bounds.hpp"
 #include "engine/io/drill_file.hpp"
 #include "tests/support/expect_invalid.hpp"
 
@@ -138,6 +139,52 @@ TEST(DrillFile, MalformedFilesNameTheField) {
             std::string::npos);
   EXPECT_NE(input_error_of([] { parse_drill_file("{", "d.json"); }).find("d.json: line 1"),
             std::string::npos);
+}
+
+// Issue 18 item 1: each bound of a drill file, at its edge (accepted) and just past it (an error
+// naming the field). Guidance points lie in the scenario workspace; targets and fall-offs within
+// ±1e6 of the metrics' units.
+TEST(DrillFile, BoundsAcceptTheirEdgeAndRejectJustPastIt) {
+  struct Bound {
+    const char* path;  // as the error names it
+    std::function<void(json&, double)> set;
+    double edge, past;
+  };
+  const double w = kWorkspaceHalfMm;
+  const Bound bounds[] = {
+      {"targets[\"rhexis.diameter_mm\"].max",
+       [](json& j, double v) { j["targets"]["rhexis.diameter_mm"]["max"] = v; }, 1e6, 1.000001e6},
+      {"targets[\"rhexis.diameter_mm\"].min",
+       [](json& j, double v) { j["targets"]["rhexis.diameter_mm"]["min"] = v; }, -1e6, -1.000001e6},
+      {"targets.lens_contacts.max",
+       [](json& j, double v) { j["targets"]["lens_contacts"]["max"] = v; }, -1e6, -1e300},
+      {"scoring[1].falloff", [](json& j, double v) { j["scoring"][1]["falloff"] = v; }, 1e6, 2e6},
+      {"guidance.puncture_site_mm[2]",
+       [](json& j, double v) { j["guidance"]["puncture_site_mm"][2] = v; }, w, w + 1e-9},
+      {"guidance.grasp_site_mm[0]",
+       [](json& j, double v) {
+         j["guidance"]["grasp_site_mm"] = {v, 0, 1.5};
+       },
+       -w, -w - 1e-9},
+      {"guidance.rhexis_circle.centre_mm[1]",
+       [](json& j, double v) { j["guidance"]["rhexis_circle"]["centre_mm"][1] = v; }, w, 1.2e19},
+      {"guidance.trench_cross.centre_mm[0]",
+       [](json& j, double v) {
+         j["guidance"]["trench_cross"] = {
+             {"centre_mm", {v, 0, 1.26}}, {"first_angle_deg", 0}, {"arm_length_mm", 2.5}};
+       },
+       -w, -1e300},
+  };
+  for (const Bound& b : bounds) {
+    json inside = valid_drill();
+    b.set(inside, b.edge);
+    EXPECT_NO_THROW(parse(inside)) << b.path << " = " << b.edge;
+    json outside = valid_drill();
+    b.set(outside, b.past);
+    const std::string e = input_error_of([&] { parse(outside); });
+    EXPECT_NE(e.find(std::string("d.json: ") + b.path + ": expected "), std::string::npos)
+        << b.path << ": " << e;
+  }
 }
 
 // "ports": the corneal ports' mode when a scenario does not choose (procedures/scene/tool_ports):

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
+#include "engine/io/bounds.hpp"
 #include "engine/io/scenario.hpp"
 #include "engine/io/track.hpp"
 #include "tests/support/expect_invalid.hpp"
@@ -277,7 +278,13 @@ const std::vector<BadCase> kBadCases = {
       "the form 'section.key'",
       "got 'youngs_modulus_kpa'"}},
     {"negative_dt.json",
-     {"negative_dt.json: dt_s: expected a time step > 0 and <= 0.1 s, got -0.01"}},
+     {"negative_dt.json: dt_s: expected a time step in 1e-05..0.1 s, got -0.01"}},
+    {"pos_beyond_workspace.json",
+     {"pos_beyond_workspace.json: hands.right.track[1].pos[0]: expected a coordinate in -50..50 mm "
+      "(the workspace around the eye's origin), got 1.2e+19"}},
+    {"t_beyond_longest_scenario.json",
+     {"t_beyond_longest_scenario.json: hands.right.track[1].t: expected a time <= 3600 s (the "
+      "longest scenario), got 1e+300"}},
     {"dt_longer_than_duration.json",
      {"dt_longer_than_duration.json: dt_s: time step 0.1 s is longer than duration_s 0.05 s"}},
     {"missing_duration.json",
@@ -303,7 +310,8 @@ const std::vector<BadCase> kBadCases = {
     {"methods_not_object.json",
      {"methods_not_object.json: methods: expected an object of \"body.setting\": \"choice\""}},
     {"methods_key_without_body.json",
-     {"methods_key_without_body.json: methods.integrator: method key must have the form 'body.setting'"}},
+     {"methods_key_without_body.json: methods.integrator: method key must have the form "
+      "'body.setting'"}},
     {"methods_value_not_string.json",
      {"methods_value_not_string.json: methods[\"capsule.integrator\"]: expected a string"}},
     {"top_level_array.json",
@@ -365,6 +373,50 @@ TEST(Scenario, DuplicateKeyDeepInTrackNamesItsPath) {
       {"tool": "forceps", "track": [{"t": 0, "pos": [0, 0, 3]}, {"t": 1, "t": 2, "pos": [0, 0, 3]}]}}})";
   EXPECT_EQ(input_error_of([&] { parse_scenario(text, "d.json", "."); }),
             "d.json: hands.left.track[1].t: duplicate field 't' (each field may appear only once)");
+}
+
+// Issue 18 item 1: each bound of a scenario, at its edge (accepted) and just past it (an error
+// naming the field): positions in the workspace (±kWorkspaceHalfMm per axis), times and the step.
+TEST(Scenario, BoundsAcceptTheirEdgeAndRejectJustPastIt) {
+  const nlohmann::json base = nlohmann::json::parse(R"({
+    "drill": "capsulorhexis", "dt_s": 0.01, "duration_s": 3600,
+    "hands": { "right": { "tool": "cystotome", "track": [
+      { "t": 0, "pos": [0, 0, 3.5] }, { "t": 2, "pos": [0, 0, 1.75], "grip": 0, "pedal": 0 } ] } }
+  })");
+  struct Bound {
+    const char* path;  // as the error names it
+    const char* pointer;
+    double edge, past;
+  };
+  const double w = kWorkspaceHalfMm;
+  const Bound bounds[] = {
+      {"hands.right.track[0].pos[0]", "/hands/right/track/0/pos/0", w, w + 1e-9},
+      {"hands.right.track[0].pos[1]", "/hands/right/track/0/pos/1", -w, -w - 1e-9},
+      {"hands.right.track[1].pos[2]", "/hands/right/track/1/pos/2", w, 1.2e19},
+      {"hands.right.track[1].pos[0]", "/hands/right/track/1/pos/0", -w, -1e300},
+      {"hands.right.track[1].t", "/hands/right/track/1/t", kMaxDurationS, kMaxDurationS + 1e-6},
+      {"dt_s", "/dt_s", kMinStepS, kMinStepS * 0.999},
+      {"dt_s", "/dt_s", kMaxStepS, kMaxStepS * 1.001},
+      {"duration_s", "/duration_s", kMaxDurationS, kMaxDurationS + 1e-6},
+      {"hands.right.track[1].grip", "/hands/right/track/1/grip", 1, 1 + 1e-9},
+      {"hands.right.track[1].pedal", "/hands/right/track/1/pedal", 3, 3 + 1e-9},
+  };
+  for (const Bound& b : bounds) {
+    nlohmann::json inside = base;
+    inside[nlohmann::json::json_pointer(b.pointer)] = b.edge;
+    EXPECT_NO_THROW(parse_scenario(inside.dump(), "b.json", ".")) << b.path << " = " << b.edge;
+    nlohmann::json outside = base;
+    outside[nlohmann::json::json_pointer(b.pointer)] = b.past;
+    const std::string e = input_error_of([&] { parse_scenario(outside.dump(), "b.json", "."); });
+    EXPECT_EQ(e.rfind(std::string("b.json: ") + b.path + ": expected ", 0), 0u)
+        << b.path << " = " << b.past << ": " << e;
+  }
+  // The message says what the workspace is.
+  nlohmann::json far = base;
+  far["hands"]["right"]["track"][1]["pos"][2] = 1e300;
+  EXPECT_EQ(input_error_of([&] { parse_scenario(far.dump(), "b.json", "."); }),
+            "b.json: hands.right.track[1].pos[2]: expected a coordinate in -50..50 mm (the "
+            "workspace around the eye's origin), got 1e+300");
 }
 
 TEST(Scenario, DamagedTextOnlyEverThrowsInputError) {

@@ -12,6 +12,7 @@
 #include "engine/core/error.hpp"
 #include "eye_test_util.hpp"
 #include "procedures/eye/eye_geometry.hpp"
+#include "procedures/eye/eye_param_ranges.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/eye/resolution.hpp"
 #include "tests/support/expect_invalid.hpp"
@@ -75,6 +76,8 @@ TEST(EyeParams, LoadRejectsBadFilesNamingFileAndPath) {
   const BadFile cases[] = {
       {"negative", "\"thickness_mm\": 0.013", "\"thickness_mm\": -0.013", "/capsule/thickness_mm"},
       {"zero", "\"z_mm\": 1.8", "\"z_mm\": 0", "/iris/z_mm"},
+      {"out of range", "\"youngs_modulus_kpa\": 2000", "\"youngs_modulus_kpa\": 1e300",
+       "/capsule/youngs_modulus_kpa: expected a number in 100..20000"},
       {"string", "\"radius_mm\": 12.0", "\"radius_mm\": \"twelve\"", "/globe/radius_mm"},
       {"missing", "\"nucleus_fraction\": 0.7,", "", "/lens/nucleus_fraction"},
       {"syntax", "\"lens\": {", "\"lens\": {{", "invalid JSON"},
@@ -128,8 +131,39 @@ TEST(EyeParams, GeometryRejectsInconsistentEyes) {
   apply_override(q, "iris.pupil_diameter_mm", 12.0);  // pupil wider than the iris
   EXPECT_THROW(eye_geometry(q), InputError);
   EyeParams r = default_eye_params();
-  apply_override(r, "lens.nucleus_fraction", 1.2);
+  apply_override(r, "cornea.posterior_apex_z_mm", 3.0);       // each in range; the cornea
+  apply_override(r, "lens.anterior_half_thickness_mm", 3.5);  // behind the lens's front
   EXPECT_THROW(eye_geometry(r), InputError);
+}
+
+// Issue 18 item 1: every eye parameter has a physical range; its edges are accepted, and a value
+// just past either edge is refused with the key and the range, leaving the value unchanged.
+TEST(EyeParams, EveryParameterHasARangeWithItsEdgesAcceptedAndJustPastRefused) {
+  const EyeParams standard = default_eye_params();
+  ASSERT_EQ(eye_param_ranges().size(), required_eye_keys().size());
+  for (const EyeParamRange& r : eye_param_ranges()) {
+    const std::string key(r.key);
+    ASSERT_LT(r.lo, r.hi) << key;
+    ASSERT_GT(r.lo, 0.0) << key << ": every eye quantity is positive";
+    const double v = standard.get(key);
+    EXPECT_TRUE(v >= r.lo && v <= r.hi) << key << " = " << v << ": the standard eye is in range";
+    for (const double edge : {r.lo, r.hi}) {
+      EyeParams p = standard;
+      EXPECT_NO_THROW(apply_override(p, key, edge)) << key << " = " << edge;
+      EXPECT_EQ(p.get(key), edge) << key;
+    }
+    for (const double past : {r.lo * (1 - 1e-9), r.hi * (1 + 1e-9), 1e300}) {
+      EyeParams p = standard;
+      const std::string msg = input_error_of([&] { apply_override(p, key, past); });
+      EXPECT_NE(msg.find("expected a number in "), std::string::npos) << key << ": " << msg;
+      EXPECT_NE(msg.find("(the physical range of " + key + ")"), std::string::npos) << msg;
+      EXPECT_EQ(p.get(key), v) << key << ": a refused override changes nothing";
+    }
+  }
+  EyeParams p = standard;
+  EXPECT_EQ(input_error_of([&] { apply_override(p, "capsule.youngs_modulus_kpa", 1e6); }),
+            "expected a number in 100..20000 (the physical range of capsule.youngs_modulus_kpa), "
+            "got 1e+06");
 }
 
 TEST(EyeGeometry, DerivedLengthsMatchDesign) {

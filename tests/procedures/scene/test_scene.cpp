@@ -9,29 +9,34 @@
 #include "engine/schedule/parallel.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/run.hpp"
+#include "procedures/scene/scene_inputs.hpp"
+#include "tests/support/expect_invalid.hpp"
 
 namespace phaco {
 namespace {
 
 std::filesystem::path cache_dir() {
   const char* env = std::getenv("PHACO_CACHE_DIR");
-  return env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "phaco-test-cache";
+  return env ? std::filesystem::path(env)
+             : std::filesystem::temp_directory_path() / "phaco-test-cache";
 }
 
 Scenario small_scenario(Drill drill = Drill::Capsulorhexis) {
   // The right hand holds a tool the drill allows (data/drills).
-  const std::string right = drill == Drill::CornealIncision ? "keratome"
+  const std::string right = drill == Drill::CornealIncision  ? "keratome"
                             : drill == Drill::PhacoSculpting ? "phaco_probe"
                                                              : "cystotome";
   const std::string text = R"({
-    "drill": ")" + std::string(to_string(drill)) + R"(",
+    "drill": ")" + std::string(to_string(drill)) +
+                           R"(",
     "eye": { "level": 0 },
     "dt_s": 0.01, "seed": 11, "duration_s": 0.5,
     "hands": {
       "left":  { "tool": "forceps", "track": [
         { "t": 0.0, "pos": [-1.0, 0.0, 3.5], "quat": [1, 0, 0, 0], "grip": 0.0 },
         { "t": 0.5, "pos": [-1.0, 0.5, 2.0], "quat": [0.7071, 0.7071, 0, 0], "grip": 1.0 } ] },
-      "right": { "tool": ")" + right + R"(", "track": [
+      "right": { "tool": ")" +
+                           right + R"(", "track": [
         { "t": 0.0, "pos": [0.0, 0.0, 3.5], "quat": [1, 0, 0, 0] },
         { "t": 0.25, "pos": [0.0, 0.0, 1.9], "quat": [1, 0, 0, 0] } ] }
     } })";
@@ -48,11 +53,15 @@ std::vector<SystemDesc> jitter_systems(Scene& scene, JitterProbe& probe) {
   const Entity capsule = *scene.body(BodyPart::Capsule);
   const uint64_t seed = scene.scenario.seed;
   std::vector<SystemDesc> s;
-  s.push_back({.name = "test_jitter", .phase = Phase::Dynamics, .reads = {"tools.pose"},
-               .writes = {"capsule.particles"}, .run = [&scene, capsule, seed](const FrameContext& ctx) {
+  s.push_back({.name = "test_jitter",
+               .phase = Phase::Dynamics,
+               .reads = {"tools.pose"},
+               .writes = {"capsule.particles"},
+               .run = [&scene, capsule, seed](const FrameContext& ctx) {
                  Particles& p = scene.world.at<Particles>(capsule);
                  const CounterRng rng(seed, 3);
-                 const float tool_z = static_cast<float>(scene.world.at<ToolState>(scene.tools[1]).pos.z());
+                 const float tool_z =
+                     static_cast<float>(scene.world.at<ToolState>(scene.tools[1]).pos.z());
                  parallel_for(0, p.slots.size(), 64, [&](uint32_t b, uint32_t e, int) {
                    for (uint32_t i = b; i < e; ++i) {
                      if (p.kind[i] != ParticleKind::Free) continue;
@@ -62,8 +71,11 @@ std::vector<SystemDesc> jitter_systems(Scene& scene, JitterProbe& probe) {
                    }
                  });
                }});
-  s.push_back({.name = "test_centroid", .phase = Phase::Metrics, .reads = {"capsule.particles"},
-               .writes = {"test.probe"}, .run = [&scene, capsule, &probe](const FrameContext&) {
+  s.push_back({.name = "test_centroid",
+               .phase = Phase::Metrics,
+               .reads = {"capsule.particles"},
+               .writes = {"test.probe"},
+               .run = [&scene, capsule, &probe](const FrameContext&) {
                  const Particles& p = scene.world.at<Particles>(capsule);
                  const float sum = parallel_reduce_ordered(
                      0u, p.slots.size(), 64, 0.0f,
@@ -167,9 +179,20 @@ TEST(Scene, BadOverrideNamesScenarioAndKey) {
     build_scene(s, o);
     FAIL() << "unknown override accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("small.json: eye.overrides.capsule.stiffnes_kpa"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("small.json: eye.overrides[\"capsule.stiffnes_kpa\"]"),
+              std::string::npos)
         << e.what();
   }
+  // Out of its physical range: refused before any mesh, naming the field and the range.
+  Scenario far = small_scenario();
+  far.eye.overrides["capsule.youngs_modulus_kpa"] = 1e300;
+  const std::string msg = test::input_error_of([&] { check_scene_inputs(far); });
+  EXPECT_NE(msg.find("small.json: eye.overrides[\"capsule.youngs_modulus_kpa\"]: expected a number "
+                     "in 100..20000"),
+            std::string::npos)
+      << msg;
+  far.eye.overrides["capsule.youngs_modulus_kpa"] = 20000;  // the edge
+  EXPECT_NO_THROW(check_scene_inputs(far));
 }
 
 // The forceps close over the capsule, lift the grasped point 0.3 mm and move it sideways: the
@@ -177,7 +200,8 @@ TEST(Scene, BadOverrideNamesScenarioAndKey) {
 Scenario grasp_scenario(const std::string& integrator) {
   const std::string text = R"({
     "drill": "capsulorhexis", "eye": { "level": 1 }, "dt_s": 0.008333333333333333, "seed": 3, "duration_s": 1.0,
-    "methods": { "capsule.integrator": ")" + integrator + R"(" },
+    "methods": { "capsule.integrator": ")" +
+                           integrator + R"(" },
     "hands": { "left": { "tool": "forceps", "track": [
       { "t": 0.0, "pos": [1.0, 0.0, 1.72], "grip": 0.0 },
       { "t": 0.1, "pos": [1.0, 0.0, 1.72], "grip": 1.0 },
@@ -187,7 +211,8 @@ Scenario grasp_scenario(const std::string& integrator) {
 }
 
 TEST(CapsulePhysics, GraspLiftsTheCapsuleLocally) {
-  for (const std::string integrator : {"implicit_euler", "implicit_predictor", "semi_implicit_001"}) {
+  for (const std::string integrator :
+       {"implicit_euler", "implicit_predictor", "semi_implicit_001"}) {
     SCOPED_TRACE(integrator);
     SceneOptions o;
     o.cache_dir = cache_dir();
@@ -211,7 +236,8 @@ TEST(CapsulePhysics, GraspLiftsTheCapsuleLocally) {
     }
     EXPECT_GT(lifted_neighbours, 3u) << "the membrane around the grasp rises with it";
     EXPECT_GT(cp.active_particle_max, 20u);
-    EXPECT_LT(cp.active_particle_max, p.slots.size() / 2) << "cost stays local: the active set is a small part";
+    EXPECT_LT(cp.active_particle_max, p.slots.size() / 2)
+        << "cost stays local: the active set is a small part";
     EXPECT_EQ(solver.state.status.fallbacks, 0u);
   }
 }
@@ -224,8 +250,10 @@ TEST(CapsulePhysics, BadMethodsAreRejectedByName) {
     build_scene(s, o);
     FAIL() << "unknown integrator accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("grasp.json: methods[\"capsule.integrator\"]: unknown choice 'runge_kutta'"),
-              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(
+                  "grasp.json: methods[\"capsule.integrator\"]: unknown choice 'runge_kutta'"),
+              std::string::npos)
+        << e.what();
   }
   s = grasp_scenario("xpbd");
   s.methods["lens.integrator"] = "xpbd";
@@ -241,8 +269,8 @@ TEST(Run, ReportHasEveryRequiredField) {
   o.threads = 2;
   const RunReport r = run_scenario(small_scenario(), o);
   const nlohmann::json j = to_json(r);
-  for (const char* key : {"drill", "sim_time_s", "frames", "threads", "systems", "peak_memory_mb", "elements",
-                          "metrics", "events", "state_hash"}) {
+  for (const char* key : {"drill", "sim_time_s", "frames", "threads", "systems", "peak_memory_mb",
+                          "elements", "metrics", "events", "state_hash"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["drill"], "capsulorhexis");

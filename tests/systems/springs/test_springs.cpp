@@ -46,15 +46,18 @@ TEST(BuildSprings, OneSpringPerEdgeWithAreaWeights) {
   ASSERT_EQ(sp.slots.size(), 5u);
   for (uint32_t e = 0; e < 5; ++e) {
     EXPECT_LT(sp.i[e], sp.j[e]);
-    if (e > 0) EXPECT_TRUE(sp.i[e - 1] < sp.i[e] || (sp.i[e - 1] == sp.i[e] && sp.j[e - 1] < sp.j[e]));
+    if (e > 0)
+      EXPECT_TRUE(sp.i[e - 1] < sp.i[e] || (sp.i[e - 1] == sp.i[e] && sp.j[e - 1] < sp.j[e]));
   }
-  // The diagonal (0,2) has both triangles: k = 2·(0.5 + 0.5)/2 = 1; a side has one: k = 2·0.5/1 = 1.
+  // The diagonal (0,2) has both triangles: k = 2·(0.5 + 0.5)/2 = 1; a side has one: k = 2·0.5/1
+  // = 1.
   for (uint32_t e = 0; e < 5; ++e) {
     EXPECT_NEAR(sp.stiffness[e], 1.0, 1e-6) << e;
     EXPECT_NEAR(sp.rest_length[e], (sp.i[e] == 0 && sp.j[e] == 2) ? std::sqrt(2.0) : 1.0, 1e-6);
   }
   const Springs uniform = springs::build_springs(
-      s.particles, s.triangles, {.weighting = StiffnessWeighting::Uniform, .sheet_modulus_mn_mm = 2.0});
+      s.particles, s.triangles,
+      {.weighting = StiffnessWeighting::Uniform, .sheet_modulus_mn_mm = 2.0});
   for (uint32_t e = 0; e < 5; ++e) EXPECT_NEAR(uniform.stiffness[e], std::sqrt(3.0), 1e-6);
 }
 
@@ -71,16 +74,42 @@ TEST(BuildSprings, AreaWeightEqualsUniformOnEquilateralTriangles) {
   }
 }
 
+// Issue 18: a cotangent pre-tension that would need a rest length below half an edge (here the
+// unit square's sides at pre-stretch 0.4: extension 1.5 × 0.4 = 0.6 of the edge) gives that edge
+// the uniform pre-stretch and counts it, as the cut's re-springing does; before, the build threw,
+// and a bowed capsule (difficulty anterior_bowing_kpa 1.9, in range) ended `phaco run` in exit 1.
+TEST(BuildSprings, CotangentPretensionTooHighForAnEdgeFallsBackToUniformAndIsCounted) {
+  Sheet s = square();
+  const springs::SpringMaterial low{.prestretch = 0.2,
+                                    .pretension = springs::Pretension::Cotangent};
+  uint32_t clamped = 0;
+  const Springs fine = springs::build_springs(s.particles, s.triangles, low, &clamped);
+  EXPECT_EQ(clamped, 0u);
+  EXPECT_NEAR(fine.rest_length[0], 1.0 - 1.5 * 0.2, 1e-6)
+      << "side (0, 1): the cotangent rest length";
+
+  springs::SpringMaterial high = low;
+  high.prestretch = 0.4;
+  const Springs sp = springs::build_springs(s.particles, s.triangles, high, &clamped);
+  EXPECT_EQ(clamped, 4u) << "the four sides; the diagonal's opposite angles are right (cot 0)";
+  for (uint32_t e = 0; e < sp.slots.size(); ++e) {
+    const bool diagonal = sp.i[e] == 0 && sp.j[e] == 2;
+    EXPECT_NEAR(sp.rest_length[e], diagonal ? std::sqrt(2.0) : 1.0 - 0.4, 1e-6) << e;
+  }
+}
+
 TEST(BuildSprings, PrestretchShortensRestLengthAndRejectsBadValues) {
   Sheet s = square();
   const Springs sp = springs::build_springs(s.particles, s.triangles, {.prestretch = 0.1});
   EXPECT_NEAR(sp.rest_length[0], 0.9, 1e-6);
-  EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = 1.0}), std::invalid_argument);
-  EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = -0.1}), std::invalid_argument);
+  EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = 1.0}),
+               std::invalid_argument);
+  EXPECT_THROW(springs::build_springs(s.particles, s.triangles, {.prestretch = -0.1}),
+               std::invalid_argument);
 }
 
-// A flat grid of right triangles with alternating diagonals (the rings-and-spokes pattern, unrolled)
-// and a jitter: not equilateral anywhere.
+// A flat grid of right triangles with alternating diagonals (the rings-and-spokes pattern,
+// unrolled) and a jitter: not equilateral anywhere.
 Sheet jittered_grid(int n) {
   SurfaceMesh m;
   for (int r = 0; r <= n; ++r) {
@@ -111,10 +140,12 @@ TEST(Pretension, CotangentBalancesInteriorVerticesUniformDoesNot) {
   Sheet s = jittered_grid(n);
   auto max_interior_force = [&](springs::Pretension mode, SpringLaw law) {
     const Springs sp = springs::build_springs(
-        s.particles, s.triangles, {.law = law, .sheet_modulus_mn_mm = 26.0, .prestretch = 0.03, .pretension = mode});
+        s.particles, s.triangles,
+        {.law = law, .sheet_modulus_mn_mm = 26.0, .prestretch = 0.03, .pretension = mode});
     Forces f;
     f.resize_zero(s.particles.slots.size());
-    springs::add_spring_forces(sp, springs::plan_blocks(sp, s.particles.slots.size()), law, s.particles, f);
+    springs::add_spring_forces(sp, springs::plan_blocks(sp, s.particles.slots.size()), law,
+                               s.particles, f);
     double worst = 0.0;
     for (int r = 1; r < n; ++r) {
       for (int c = 1; c < n; ++c) {
@@ -142,7 +173,8 @@ TEST(SpringForces, NoForceAtRestAndNewtonsThirdLawUnderLoad) {
     for (uint32_t i = 0; i < s.particles.slots.size(); ++i) ASSERT_NEAR(f.fx[i], 0.0f, 1e-6f);
 
     Particles moved = s.particles;
-    for (uint32_t i = 0; i < moved.slots.size(); ++i) moved.z[i] += 0.01f * std::sin(0.37f * static_cast<float>(i));
+    for (uint32_t i = 0; i < moved.slots.size(); ++i)
+      moved.z[i] += 0.01f * std::sin(0.37f * static_cast<float>(i));
     f.resize_zero(moved.slots.size());
     springs::add_spring_forces(sp, blocks, law, moved, f);
     double sx = 0, sy = 0, sz = 0, mag = 0;
@@ -161,10 +193,12 @@ TEST(SpringForces, NoForceAtRestAndNewtonsThirdLawUnderLoad) {
 TEST(SpringForces, ForceIsMinusEnergyGradient) {
   Sheet s = capsule(0);
   for (SpringLaw law : {SpringLaw::Linear, SpringLaw::Quadratic}) {
-    const Springs sp = springs::build_springs(s.particles, s.triangles, {.law = law, .prestretch = 0.05});
+    const Springs sp =
+        springs::build_springs(s.particles, s.triangles, {.law = law, .prestretch = 0.05});
     const SpringBlocks blocks = springs::plan_blocks(sp, s.particles.slots.size());
     Particles p = s.particles;
-    for (uint32_t i = 0; i < p.slots.size(); ++i) p.x[i] += 0.02f * std::cos(1.3f * static_cast<float>(i));
+    for (uint32_t i = 0; i < p.slots.size(); ++i)
+      p.x[i] += 0.02f * std::cos(1.3f * static_cast<float>(i));
     Forces f;
     f.resize_zero(p.slots.size());
     springs::add_spring_forces(sp, blocks, law, p, f);
@@ -207,8 +241,10 @@ TEST(SpringBlocks, RejectsUnsortedSprings) {
   EXPECT_THROW(springs::plan_blocks(sp, 4), std::invalid_argument);
 }
 
-std::vector<float> forces_with_threads(int threads, const Sheet& s, const Springs& sp, const SpringBlocks& b) {
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
+std::vector<float> forces_with_threads(int threads, const Sheet& s, const Springs& sp,
+                                       const SpringBlocks& b) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                            static_cast<size_t>(threads));
   tbb::task_arena arena(threads);
   Forces f;
   f.resize_zero(s.particles.slots.size());
@@ -221,7 +257,8 @@ std::vector<float> forces_with_threads(int threads, const Sheet& s, const Spring
 
 TEST(SpringForces, BitIdenticalForOneTwoAndFourThreads) {
   Sheet s = capsule(3);
-  for (uint32_t i = 0; i < s.particles.slots.size(); ++i) s.particles.z[i] += 0.003f * std::sin(0.1f * i);
+  for (uint32_t i = 0; i < s.particles.slots.size(); ++i)
+    s.particles.z[i] += 0.003f * std::sin(0.1f * i);
   const Springs sp = springs::build_springs(s.particles, s.triangles, {.prestretch = 0.02});
   const SpringBlocks b = springs::plan_blocks(sp, s.particles.slots.size(), 64);
   const auto one = forces_with_threads(1, s, sp, b);
