@@ -52,6 +52,11 @@ int drills(int release_count) {
   if (const char* env = std::getenv("PHACO_SCENE_FUZZ_DRILLS")) return std::max(1, std::atoi(env));
   return test::asan_scaled(release_count, 4);
 }
+// PHACO_SCENE_FUZZ_SEED=S starts the drills' seeds at S instead of 1800.
+uint64_t first_seed() {
+  const char* env = std::getenv("PHACO_SCENE_FUZZ_SEED");
+  return env ? std::strtoull(env, nullptr, 10) : 1800;
+}
 const int kRhexisDrills = drills(24);
 const int kIncisionDrills = drills(48);
 constexpr uint64_t kEveryFrames = 30;  // also check frames without a topology change
@@ -323,8 +328,8 @@ template <class MakeScenario>
 void fuzz(const char* kind, int count, MakeScenario make, uint64_t& cut_drills,
           FuzzOutcome& total) {
   for (int k = 0; k < count; ++k) {
-    const uint64_t seed = 1800 + static_cast<uint64_t>(k);
-    const int level = k % 2;
+    const uint64_t seed = first_seed() + static_cast<uint64_t>(k);
+    const int level = static_cast<int>(seed % 2);
     const Scenario s = make(seed, level);
     const FuzzOutcome r = run_checked(s, kDeformedShape, kRestShape);
     total.checks += r.checks;
