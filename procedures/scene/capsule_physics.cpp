@@ -151,7 +151,7 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
             CapsuleStats& stats = scene.world.at<CapsuleStats>(capsule);
             if constexpr (topology_check::kCheckEveryFrame) {
               // Debug builds check the membrane's structural invariants every frame (issue 4 item
-              // 4): edges, orientation, springs = edges, indices, no NaN. The area and angle bounds
+              // 4): edges, vertex fans, orientation, springs = edges, indices, no NaN. The area and angle bounds
               // are zero here: a pulled membrane legitimately squeezes triangles (0.24° seen in the
               // demo); those bounds judge the mesh a cut produces, not the deformed shape.
               static const topology_check::InvariantThresholds kStructuralOnly{0.0, 0.0};

@@ -100,6 +100,26 @@ void sort_by_key(std::vector<T>& items, std::vector<T>& out, std::vector<uint32_
   items.swap(out);
 }
 
+// Union-find over triangle corners (3·t + k), path halving; the smaller index becomes the root so
+// the sets, and the records naming them, do not depend on the order of the unions.
+uint32_t find_set(uint32_t* parent, uint32_t x) {
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+void unite_sets(uint32_t* parent, uint32_t a, uint32_t b) {
+  a = find_set(parent, a);
+  b = find_set(parent, b);
+  if (a != b) parent[std::max(a, b)] = std::min(a, b);
+}
+
+// Corner of valid triangle t at particle q (q is one of its three).
+uint32_t corner_of(const uint32_t* ta, const uint32_t* tb, uint32_t t, uint32_t q) {
+  return 3 * t + (ta[t] == q ? 0u : tb[t] == q ? 1u : 2u);
+}
+
 bool finite3(float a, float b, float c) {
   return std::isfinite(a) && std::isfinite(b) && std::isfinite(c);
 }
@@ -176,6 +196,7 @@ void check_triangles(const Particles& p, uint32_t particle_usable, const Triangl
   const uint32_t *ta = tri.a.data(), *tb = tri.b.data(), *tc = tri.c.data();
   const float *x = p.x.data(), *y = p.y.data(), *z = p.z.data();
   s.half_edges.resize(size_t{usable} * 3);
+  s.valid.assign(usable, 0);
   HalfEdge* he = s.half_edges.data();
   size_t edge_count = 0;
   for (uint32_t t = 0; t < usable; ++t) {
@@ -209,6 +230,7 @@ void check_triangles(const Particles& p, uint32_t particle_usable, const Triangl
           format("triangle %u (%u, %u, %u): particle %u repeated", t, v[0], v[1], v[2], repeated));
       continue;
     }
+    s.valid[t] = 1;
     for (int k = 0; k < 3; ++k) {
       const uint32_t u = v[k];
       const uint32_t w = v[(k + 1) % 3];
@@ -221,12 +243,17 @@ void check_triangles(const Particles& p, uint32_t particle_usable, const Triangl
   s.half_edges.resize(edge_count);
 }
 
-// One walk over the sorted half-edges: distinct edges, non-manifold edges, orientation.
-void check_edges(uint32_t particle_usable, uint32_t triangle_usable, InvariantScratch& s,
-                 Recorder& rec) {
+// One walk over the sorted half-edges: distinct edges, non-manifold edges, orientation; and the
+// corners of the triangles sharing an edge joined at both its ends (check_vertices counts them).
+void check_edges(const Triangles& tri, uint32_t particle_usable, uint32_t triangle_usable,
+                 InvariantScratch& s, Recorder& rec) {
   sort_by_key(s.half_edges, s.sorted_half_edges, s.bucket, particle_usable);
   s.interior_count.assign(triangle_usable, 0);
   s.bad_count.assign(triangle_usable, 0);
+  s.corner_set.resize(size_t{triangle_usable} * 3);
+  uint32_t* corner_set = s.corner_set.data();
+  for (uint32_t c = 0; c < 3 * triangle_usable; ++c) corner_set[c] = c;
+  const uint32_t *ta = tri.a.data(), *tb = tri.b.data();
   const HalfEdge* he = s.half_edges.data();
   const size_t n = s.half_edges.size();
   uint8_t* interior_count = s.interior_count.data();
@@ -235,6 +262,15 @@ void check_edges(uint32_t particle_usable, uint32_t triangle_usable, InvariantSc
     while (j < n && he[j].key == he[i].key) ++j;
     const size_t uses = j - i;
     s.edges.push_back(he[i]);
+    // Joined across an edge of more than two triangles too: that edge is its own record, and
+    // the vertex check then names only fans that touch at the vertex and nowhere else.
+    const uint32_t lo = key_lo(he[i].key), hi = key_hi(he[i].key);
+    for (size_t k = i + 1; k < j; ++k) {
+      unite_sets(corner_set, corner_of(ta, tb, he[i].triangle, lo),
+                 corner_of(ta, tb, he[k].triangle, lo));
+      unite_sets(corner_set, corner_of(ta, tb, he[i].triangle, hi),
+                 corner_of(ta, tb, he[k].triangle, hi));
+    }
     if (uses > 2) {
       rec.add(Violation::EdgeWithMoreThanTwoTriangles, ElementTable::Triangle, he[j - 1].triangle,
               he[i].triangle,
@@ -273,6 +309,47 @@ void check_edges(uint32_t particle_usable, uint32_t triangle_usable, InvariantSc
             format("triangle %u runs %u of its %u shared edges the same way as its neighbour "
                    "(e.g. triangle %u)",
                    t, unsigned{s.bad_count[t]}, unsigned{s.interior_count[t]}, other));
+  }
+}
+
+// Fans per particle: the corner sets whose root lies at it. A particle with two or more is a
+// bowtie; its record names its lowest-index triangle's fan and a triangle outside it.
+void check_vertices(const Triangles& tri, uint32_t particle_usable, uint32_t triangle_usable,
+                    InvariantScratch& s, Recorder& rec) {
+  s.fans.assign(particle_usable, 0);
+  uint32_t* fans = s.fans.data();
+  uint32_t* corner_set = s.corner_set.data();
+  const uint8_t* valid = s.valid.data();
+  const std::array<const uint32_t*, 3> corner = {tri.a.data(), tri.b.data(), tri.c.data()};
+  bool any = false;
+  for (uint32_t t = 0; t < triangle_usable; ++t) {
+    if (!valid[t]) continue;
+    for (uint32_t k = 0; k < 3; ++k) {
+      if (find_set(corner_set, 3 * t + k) != 3 * t + k) continue;
+      any = any || fans[corner[k][t]] > 0;
+      ++fans[corner[k][t]];
+    }
+  }
+  if (!any) return;
+  // Only on a violation: per particle, the first fan's root (its lowest corner) and whether the
+  // particle has been reported.
+  std::vector<uint32_t> first_fan(particle_usable, kInvalidIndex);
+  for (uint32_t t = 0; t < triangle_usable; ++t) {
+    if (!valid[t]) continue;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t q = corner[k][t];
+      if (fans[q] < 2) continue;
+      const uint32_t root = find_set(corner_set, 3 * t + k);
+      if (first_fan[q] == kInvalidIndex) {
+        first_fan[q] = root;
+      } else if (root != first_fan[q]) {
+        rec.add(Violation::NonManifoldVertex, ElementTable::Particle, q, t,
+                format("particle %u: its triangles form %u fans touching only at it (triangle %u "
+                       "and triangle %u are in different fans)",
+                       q, fans[q], first_fan[q] / 3, t));
+        fans[q] = 0;  // reported once
+      }
+    }
   }
 }
 
@@ -379,6 +456,8 @@ std::string_view to_string(Violation v) {
       return "SpringIndexOrder";
     case Violation::NonFiniteSpring:
       return "NonFiniteSpring";
+    case Violation::NonManifoldVertex:
+      return "NonManifoldVertex";
   }
   return "Unknown";
 }
@@ -445,7 +524,8 @@ InvariantReport check_membrane(const Particles& particles, const Triangles& tria
                                   springs.rest_length, springs.stiffness);
   check_particles(p, np, rec);
   check_triangles(p, np, triangles, nt, thresholds, scratch, rec);
-  check_edges(np, nt, scratch, rec);
+  check_edges(triangles, np, nt, scratch, rec);
+  check_vertices(triangles, np, nt, scratch, rec);
   check_springs(p, np, springs, ns, scratch, rec);
   return report;
 }

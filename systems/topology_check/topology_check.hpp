@@ -10,13 +10,19 @@
 //    min_angle_deg;
 //  - every edge used by at most two triangles, and an interior edge traversed in opposite
 //    directions by its two triangles (consistent orientation);
+//  - every vertex manifold: its triangles, joined through the edges they share at it, form one
+//    fan. With every edge on at most two triangles, one fan is one disc (interior vertex) or one
+//    half-disc (boundary vertex); two fans touching only at the vertex (a bowtie) are what a cut's
+//    vertex duplication must never leave, and the edge checks alone cannot see them;
 //  - the spring set equals the edge set, as unordered particle pairs, with no duplicate spring and
 //    i < j in every spring (components/springs.hpp).
 //
 // How: the three directed edges of every valid triangle go into one array keyed by the unordered
 // pair, sorted (counting sort on the lower particle, then by the upper: O(n), no hashing,
 // deterministic) and walked once; the alive springs' pairs are sorted the same way and merged
-// against the distinct edges. Scratch arrays live in
+// against the distinct edges. The same walk joins, across each shared edge, the two triangles'
+// corners at its ends (union-find over corners 3·triangle + k); a vertex whose corners end in more
+// than one set is a bowtie. Scratch arrays live in
 // InvariantScratch so a caller that checks every frame allocates nothing once warmed up (only a
 // violation's record allocates). Single-threaded; timings in docs/topology_invariants.md.
 //
@@ -67,8 +73,10 @@ enum class Violation : uint8_t {
   DuplicateSpring,          // element: the later spring, other: the first spring with that pair
   SpringIndexOrder,         // element: spring with i >= j
   NonFiniteSpring,          // element: spring whose rest length or stiffness is NaN/inf/negative
+  NonManifoldVertex,        // element: particle whose triangles form more than one fan (a bowtie),
+                            // other: a triangle outside the fan of its lowest-index triangle
 };
-inline constexpr int kViolationKinds = 13;
+inline constexpr int kViolationKinds = 14;
 
 std::string_view to_string(Violation v);
 
@@ -118,6 +126,9 @@ struct InvariantScratch {
   std::vector<uint8_t> interior_count;  // per triangle slot: interior (two-triangle) edges
   std::vector<uint8_t> bad_count;       // per triangle slot: same-direction interior edges
   std::vector<uint8_t> blamed;          // per triangle slot
+  std::vector<uint8_t> valid;           // per triangle slot: alive, indices good, no repeat
+  std::vector<uint32_t> corner_set;     // per corner 3·t + k: union-find parent
+  std::vector<uint32_t> fans;           // per particle: fans (corner sets) around it
 };
 
 InvariantReport check_membrane(const Particles& particles, const Triangles& triangles,

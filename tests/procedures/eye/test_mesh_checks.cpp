@@ -5,6 +5,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/core/mesh_checks.hpp"
+#include "tests/support/fan_meshes.hpp"
 
 namespace phaco {
 namespace {
@@ -72,6 +73,20 @@ TEST(MeshChecks, BowtieVertexIsNonManifold) {
   EXPECT_EQ(t.nonmanifold_vertices, 1u);
   EXPECT_FALSE(t.manifold());
   EXPECT_EQ(t.boundary_loops, 1u);  // the two loops touch at vertex 0
+}
+
+// Hand-made fans around vertex 0 (tests/support/fan_meshes.hpp): only one disc or one half-disc
+// is manifold; two fans meeting only at the vertex are one non-manifold vertex whether they are
+// boundary fans or closed discs.
+TEST(MeshChecks, EachVertexIsOneDiscOrOneHalfDisc) {
+  for (const test::FanMesh& f : test::fan_meshes()) {
+    SCOPED_TRACE(f.name);
+    const SurfaceTopology t = check_surface(f.mesh);
+    EXPECT_EQ(t.nonmanifold_edges, 0u);
+    EXPECT_EQ(t.nonmanifold_vertices, f.fans_at_0 == 1 ? 0u : 1u);
+    EXPECT_EQ(t.manifold(), f.fans_at_0 == 1);
+    EXPECT_EQ(t.degenerate_triangles, 0u);
+  }
 }
 
 TEST(MeshChecks, DegenerateAndUnreferencedAreCounted) {

@@ -8,10 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "tests/support/membrane_tables.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/springs/springs.hpp"
 #include "systems/topology_check/topology_check.hpp"
+#include "tests/support/fan_meshes.hpp"
+#include "tests/support/membrane_tables.hpp"
 
 namespace phaco {
 namespace {
@@ -260,6 +261,19 @@ std::vector<Case> cases() {
        Violation::NonFiniteSpring,
        ElementTable::Spring,
        {}},
+      {"TriangleTouchingTheGridOnlyAtACorner",
+       [](Membrane& m) {
+         // Corner 24 at (4, 4) gets a second fan: a triangle beyond it, sharing no edge.
+         const uint32_t p = add_particle(m, 5.0f, 4.0f, 0.0f);
+         const uint32_t q = add_particle(m, 5.0f, 5.0f, 0.0f);
+         add_spring(m, 24, p);
+         add_spring(m, p, q);
+         add_spring(m, 24, q);
+         return std::pair{24u, add_triangle(m, 24, p, q)};
+       },
+       Violation::NonManifoldVertex,
+       ElementTable::Particle,
+       {}},
       {"NegativeRestLength",
        [](Membrane& m) {
          const uint32_t e = spring_of(m.springs, 0, 1);
@@ -307,6 +321,62 @@ TEST(CheckMembrane, EachCorruptionIsReportedOnceWithItsElement) {
     EXPECT_TRUE(check_membrane(clean.particles, clean.triangles, clean.springs, {}, scratch).ok());
   }
   EXPECT_EQ(covered.size(), static_cast<size_t>(topology_check::kViolationKinds));
+}
+
+// Hand-made fans around vertex 0 (tests/support/fan_meshes.hpp): a disc and a half-disc pass; a
+// bowtie, two or three boundary fans, two discs, a disc and a triangle are one record each, at
+// vertex 0, naming a triangle of another fan, and nothing else is reported.
+TEST(CheckMembrane, EachVertexIsOneDiscOrOneHalfDisc) {
+  InvariantScratch scratch;
+  for (const test::FanMesh& f : test::fan_meshes()) {
+    SCOPED_TRACE(f.name);
+    const Membrane m = from_mesh(f.mesh);
+    const InvariantReport r = check_membrane(m.particles, m.triangles, m.springs, {}, scratch);
+    if (f.fans_at_0 == 1) {
+      EXPECT_TRUE(r.ok()) << r.summary();
+      continue;
+    }
+    ASSERT_EQ(r.violations.size(), 1u) << r.summary();
+    const auto& v = r.violations.front();
+    EXPECT_EQ(v.kind, Violation::NonManifoldVertex);
+    EXPECT_EQ(v.table, ElementTable::Particle);
+    EXPECT_EQ(v.element, 0u);
+    EXPECT_EQ(v.other, f.second_fan_triangle);
+    EXPECT_NE(v.detail.find(std::to_string(f.fans_at_0) + " fans"), std::string::npos) << v.detail;
+  }
+}
+
+// Cuts along the grid's row j = 2 made by hand: the triangles above the row (16..31) moved to
+// copies of the row's vertices that the cut split. Each edge keeps at most two triangles, so the
+// edge checks pass whatever is split; only the vertex check sees a cut through vertex 12 that
+// forgot to duplicate it, where the two sides then touch: a bowtie.
+TEST(CheckMembrane, ACutThroughAVertexItDidNotDuplicateLeavesABowtie) {
+  auto cut = [](std::vector<uint32_t> split) {
+    Membrane m = grid();
+    std::vector<uint32_t> copy(kN * kN, kInvalidIndex);
+    for (uint32_t v : split)
+      copy[v] = add_particle(m, m.particles.x[v], m.particles.y[v], m.particles.z[v]);
+    for (uint32_t t = 16; t < 32; ++t) {
+      for (uint32_t* c : {&m.triangles.a[t], &m.triangles.b[t], &m.triangles.c[t]})
+        if (copy[*c] != kInvalidIndex) *c = copy[*c];
+    }
+    m.springs = springs::build_springs(m.particles, m.triangles, {});
+    return m;
+  };
+  const Membrane missed = cut({10, 11, 13, 14});  // across the sheet, 12 not duplicated
+  const InvariantReport r = check_membrane(missed.particles, missed.triangles, missed.springs);
+  ASSERT_EQ(r.violations.size(), 1u) << r.summary();
+  EXPECT_EQ(r.violations.front().kind, Violation::NonManifoldVertex);
+  EXPECT_EQ(r.violations.front().element, 12u);
+  // A slit from the rim ending at 12: the tip is shared by both sides through edge (12, 13).
+  const Membrane slit = cut({10, 11});
+  const InvariantReport tip = check_membrane(slit.particles, slit.triangles, slit.springs);
+  EXPECT_TRUE(tip.ok()) << tip.summary();
+  // Across the sheet with 12 duplicated too: two halves, each a manifold.
+  const Membrane through = cut({10, 11, 12, 13, 14});
+  const InvariantReport halves =
+      check_membrane(through.particles, through.triangles, through.springs);
+  EXPECT_TRUE(halves.ok()) << halves.summary();
 }
 
 TEST(CheckMembrane, ShortColumnIsReportedWithoutReadingPastIt) {
