@@ -7,15 +7,15 @@
 #include <string>
 
 #include "engine/core/math.hpp"
+#include "engine/core/workspace.hpp"
 
 namespace phaco {
 
-// The workspace: every position a file gives (track samples, drill guidance points) lies within
-// ±kWorkspaceHalfMm of the eye's origin on each axis. The globe's radius is 12 mm (DESIGN.md §6),
-// so 50 mm leaves room for a tool held well away from the eye, while every coordinate stays small
-// enough that squares, spans and bounding boxes of tool paths are finite (a tool at 1e300 mm made
-// a histogram of tool speeds, and a port's arc, non-finite: issue 18).
-inline constexpr double kWorkspaceHalfMm = 50.0;
+// The workspace (engine/core/workspace.hpp, shared with the devices' sample bounds): every
+// position a file gives (track samples, drill guidance points) lies within ±kWorkspaceHalfMm of
+// the eye's origin on each axis, so every coordinate stays small enough that squares, spans and
+// bounding boxes of tool paths are finite (a tool at 1e300 mm made a histogram of tool speeds,
+// and a port's arc, non-finite: issue 18).
 // The fixed step: 100 kHz at the finest (ten times the haptic rate), 10 Hz at the coarsest
 // (coarser steps cannot resolve tool contact).
 inline constexpr double kMinStepS = 1e-5;
