@@ -192,6 +192,9 @@ int run_trainer(const TrainerOptions& o) {
                                           : nlohmann::json();
         s.haptic_period_p99_us = period.is_object() ? period.value("p99_us", 0.0) : 0.0;
         s.haptic_period_max_us = period.is_object() ? period.value("max_us", 0.0) : 0.0;
+        if (r.contains("live"))
+          s.haptic_fifo =
+              r["live"]["haptics"].value("realtime", nlohmann::json::object()).value("fifo", false);
         FrameClock drill_frames;
         drill_frames.ms.assign(frames.ms.begin() + static_cast<std::ptrdiff_t>(soak_frame0),
                                frames.ms.end());

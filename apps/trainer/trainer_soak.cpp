@@ -56,6 +56,7 @@ void write_soak(const std::filesystem::path& file, const std::vector<SoakSample>
                     {"gl_framebuffers", s.gl_framebuffers},
                     {"haptic_period_p99_us", s.haptic_period_p99_us},
                     {"haptic_period_max_us", s.haptic_period_max_us},
+                    {"haptic_fifo", s.haptic_fifo},
                     {"render_frame_p99_ms", s.render_frame_p99_ms},
                     {"score", s.score}});
   }

@@ -20,6 +20,7 @@ struct SoakSample {
   double rss_mb = 0;  // VmRSS, MiB
   int gl_buffers = 0, gl_vertex_arrays = 0, gl_textures = 0, gl_programs = 0, gl_framebuffers = 0;
   double haptic_period_p99_us = 0, haptic_period_max_us = 0;
+  bool haptic_fifo = false;        // the haptic thread got SCHED_FIFO for this drill
   double render_frame_p99_ms = 0;  // the render loop over this drill
   double score = 0;                // the drill's score (a sanity check that drills really ran)
 };
