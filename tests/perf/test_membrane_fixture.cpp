@@ -67,11 +67,13 @@ TEST(PlainStep, BitIdenticalForOneAndTwoThreadsAndSagsUnderLoad) {
   EXPECT_LT(one[rest.centre], rest.particles.z[rest.centre] - 1e-5f);  // pushed down
 }
 
-TEST(Bandwidth, TriadGivesPlausibleFigure) {
+TEST(Bandwidth, TriadGivesAFigure) {
+  // Only that a figure comes out: how large it is is the harness's to report (phaco-perf
+  // bandwidth), not a test's to assert on a machine that may be busy (issue 18).
   const Bandwidth b = measure_bandwidth("triad", 8 << 20, 1, 2);
   EXPECT_EQ(b.kernel, "triad");
-  EXPECT_GT(b.gb_per_s, 0.1);
-  EXPECT_LT(b.gb_per_s, 10000.0);
+  EXPECT_TRUE(std::isfinite(b.gb_per_s));
+  EXPECT_GT(b.gb_per_s, 0.0);
   EXPECT_THROW(measure_bandwidth("scale", 1 << 20, 1, 1), std::invalid_argument);
 }
 
