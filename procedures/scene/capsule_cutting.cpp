@@ -293,9 +293,8 @@ void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const
 }  // namespace
 
 bool add_capsule_cutting(Scene& scene) {
-  if (method_choice(scene, "capsule.cutting", "on", {"on", "off"}) == "off") return false;
-  const std::string rule = method_choice(scene, "capsule.tear_rule", "flap_force",
-                                         {"flap_force", "most_stressed_spring"});
+  if (method_choice(scene, "capsule.cutting", "on") == "off") return false;
+  const std::string rule = method_choice(scene, "capsule.tear_rule", "flap_force");
 
   const Entity capsule = *scene.body(BodyPart::Capsule);
   Particles& p = scene.world.at<Particles>(capsule);

@@ -9,6 +9,7 @@
 #include "components/triangles.hpp"
 #include "engine/core/error.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
+#include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/springs/springs.hpp"
 #include "systems/topology_check/topology_check.hpp"
@@ -24,17 +25,8 @@ constexpr std::array<std::string_view, 9> kCapsuleMethods = {
 
 }  // namespace
 
-std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback,
-                          std::initializer_list<std::string_view> allowed) {
-  const auto it = scene.scenario.methods.find(key);
-  if (it == scene.scenario.methods.end()) return fallback;
-  for (std::string_view a : allowed) {
-    if (it->second == a) return it->second;
-  }
-  std::string names;
-  for (std::string_view a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
-  throw InputError(scene.scenario.source + ": methods[\"" + key + "\"]: unknown choice '" +
-                   it->second + "'; expected one of: " + names);
+std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback) {
+  return method_value(scene.scenario, key, fallback);
 }
 
 bool is_capsule_method(const std::string& key) {
@@ -50,21 +42,14 @@ void add_capsule_physics(Scene& scene) {
   const Triangles& triangles = scene.world.at<Triangles>(capsule);
   const eye::EyeParams& params = scene.params;
 
-  const std::string integrator =
-      method_choice(scene, "capsule.integrator", "implicit_euler",
-                    {"explicit_euler", "symplectic_euler", "semi_implicit_001", "implicit_euler",
-                     "implicit_predictor", "xpbd"});
-  const std::string law =
-      method_choice(scene, "capsule.spring_law", "linear", {"linear", "quadratic"});
-  const std::string stiffness =
-      method_choice(scene, "capsule.stiffness", "area_weighted", {"area_weighted", "uniform"});
-  const std::string pretension =
-      method_choice(scene, "capsule.pretension", "cotangent", {"cotangent", "uniform_prestretch"});
-  const std::string active = method_choice(scene, "capsule.active_set", "on", {"on", "off"});
+  const std::string integrator = method_choice(scene, "capsule.integrator", "implicit_euler");
+  const std::string law = method_choice(scene, "capsule.spring_law", "linear");
+  const std::string stiffness = method_choice(scene, "capsule.stiffness", "area_weighted");
+  const std::string pretension = method_choice(scene, "capsule.pretension", "cotangent");
+  const std::string active = method_choice(scene, "capsule.active_set", "on");
   const std::string preconditioner =
       method_choice(scene, "capsule.preconditioner",
-                    std::string(to_string(deform::ImplicitSettings{}.preconditioner)),
-                    {"jacobi", "block_jacobi", "incomplete_cholesky", "two_level"});
+                    std::string(to_string(deform::ImplicitSettings{}.preconditioner)));
 
   CapsuleSettings cs;
   CapsuleSprings sp;
@@ -102,16 +87,8 @@ void add_capsule_physics(Scene& scene) {
   solver.state.implicit.settings.preconditioner = *deform::parse_preconditioner(preconditioner);
   // The implicit step's relative CG tolerance (default ImplicitSettings'); the sweep's converged
   // reference tightens it (perf/sweep/sweep_reference.hpp).
-  if (const auto it = scene.scenario.methods.find("capsule.cg_tolerance");
-      it != scene.scenario.methods.end()) {
-    char* end = nullptr;
-    const double tol = std::strtod(it->second.c_str(), &end);
-    if (end == it->second.c_str() || *end != '\0' || !(tol > 0.0 && tol < 1.0))
-      throw InputError(scene.scenario.source +
-                       ": methods[\"capsule.cg_tolerance\"]: expected a number in (0, 1), got '" +
-                       it->second + "'");
-    solver.state.implicit.settings.cg_tolerance = tol;
-  }
+  if (const std::string tol = method_choice(scene, "capsule.cg_tolerance", ""); !tol.empty())
+    solver.state.implicit.settings.cg_tolerance = std::strtod(tol.c_str(), nullptr);
 
   cs.environment.has_lens = true;
   cs.environment.lens_radius_mm = 0.5 * params.get("lens.equatorial_diameter_mm");
@@ -151,9 +128,10 @@ SystemDesc capsule_dynamics_system(Scene& scene) {
             CapsuleStats& stats = scene.world.at<CapsuleStats>(capsule);
             if constexpr (topology_check::kCheckEveryFrame) {
               // Debug builds check the membrane's structural invariants every frame (issue 4 item
-              // 4): edges, vertex fans, orientation, springs = edges, indices, no NaN. The area and angle bounds
-              // are zero here: a pulled membrane legitimately squeezes triangles (0.24° seen in the
-              // demo); those bounds judge the mesh a cut produces, not the deformed shape.
+              // 4): edges, vertex fans, orientation, springs = edges, indices, no NaN. The area and
+              // angle bounds are zero here: a pulled membrane legitimately squeezes triangles
+              // (0.24° seen in the demo); those bounds judge the mesh a cut produces, not the
+              // deformed shape.
               static const topology_check::InvariantThresholds kStructuralOnly{0.0, 0.0};
               const auto report = topology_check::check_membrane(
                   p, scene.world.at<Triangles>(capsule), sp.springs, kStructuralOnly);

@@ -99,9 +99,8 @@ struct ToolGrasp {
 };
 
 // The scenario's choice for a `methods` key, `fallback` if absent; InputError naming the key and
-// the allowed choices otherwise.
-std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback,
-                          std::initializer_list<std::string_view> allowed);
+// its choices (procedures/scene/method_settings.hpp, the one table of them) otherwise.
+std::string method_choice(const Scene& scene, const std::string& key, const std::string& fallback);
 
 // Known `methods` keys for the capsule; every other "capsule.*" key is rejected by the scene.
 bool is_capsule_method(const std::string& key);

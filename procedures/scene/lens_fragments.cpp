@@ -21,7 +21,7 @@ constexpr double kRhexisRadiusMm = 2.6;
 }  // namespace
 
 std::string lens_model(const Scene& scene) {
-  return method_choice(scene, "lens.model", "tets", {"tets", "fragments"});
+  return method_choice(scene, "lens.model", "tets");
 }
 
 void add_lens_fragments(Scene& scene) {

@@ -64,10 +64,8 @@ void add_lens_sculpting(Scene& scene) {
   const Tets& tets = scene.world.at<Tets>(lens);
   const eye::EyeParams& params = scene.params;
 
-  const std::string broadphase =
-      method_choice(scene, "lens.broadphase", "octree", {"octree", "dbvt"});
-  const std::string narrowphase =
-      method_choice(scene, "lens.narrowphase", "centre", {"centre", "exact_gjk", "exact_mpr"});
+  const std::string broadphase = method_choice(scene, "lens.broadphase", "octree");
+  const std::string narrowphase = method_choice(scene, "lens.narrowphase", "centre");
 
   LensSculpting ls;
   TetMesh mesh = tet_mesh_of(p, tets);

@@ -23,6 +23,7 @@
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
+#include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/scene_inputs.hpp"
 #include "procedures/scene/tool_ports.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
@@ -313,6 +314,7 @@ SceneInputs check_scene_inputs(const Scenario& scenario) {
   std::vector<BodyPart> parts;
   for (const std::string& name : in.drill.bodies) parts.push_back(body_part(name));
   check_methods(scenario, parts);
+  check_method_values(scenario, in.drill);
   return in;
 }
 

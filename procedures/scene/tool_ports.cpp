@@ -8,6 +8,7 @@
 #include "components/tool.hpp"
 #include "engine/core/error.hpp"
 #include "procedures/eye/eye_geometry.hpp"
+#include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/scene.hpp"
 
 namespace phaco {
@@ -91,13 +92,8 @@ bool is_ports_method(const std::string& key) {
 }
 
 std::string ports_mode(const Scene& scene) {
-  const auto it = scene.scenario.methods.find("tools.ports");
   // The drill file's "ports" (validated by engine/io/drill_file) when the scenario does not say.
-  if (it == scene.scenario.methods.end()) return scene.drill.ports;
-  if (it->second == "off" || it->second == "measure" || it->second == "constrain")
-    return it->second;
-  throw InputError(scene.scenario.source + ": methods[\"tools.ports\"]: unknown choice '" +
-                   it->second + "'; expected one of: off, measure, constrain");
+  return method_value(scene.scenario, "tools.ports", scene.drill.ports);
 }
 
 std::optional<SystemDesc> tool_ports_system(Scene& scene) {

@@ -8,6 +8,7 @@
 #include "engine/core/rng.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/run.hpp"
 #include "procedures/scene/scene_inputs.hpp"
 #include "tests/support/expect_invalid.hpp"
@@ -261,6 +262,38 @@ TEST(CapsulePhysics, BadMethodsAreRejectedByName) {
   s = grasp_scenario("xpbd");
   s.drill = Drill::CornealIncision;
   EXPECT_THROW(build_scene(s, o), InputError) << "the incision scene has no capsule";
+}
+
+// Method values are checked before any mesh (issue 18: what validate accepts, run runs): each
+// key's choices from the one table, the CG tolerance a number in (0, 1), lens sculpting settings
+// only with the tetrahedral lens, ports only where the drill file gives their sites.
+TEST(CapsulePhysics, BadMethodValuesAreRefusedBeforeAnyMesh) {
+  const auto refused = [](Scenario s, const std::string& key, const std::string& value,
+                          const std::string& expected) {
+    s.methods[key] = value;
+    const std::string msg = test::input_error_of([&] { check_scene_inputs(s); });
+    EXPECT_NE(msg.find("methods[\"" + key + "\"]: " + expected), std::string::npos)
+        << key << " = " << value << ": " << msg;
+  };
+  const Scenario rhexis = grasp_scenario("xpbd");
+  refused(rhexis, "capsule.integrator", "runge_kutta", "unknown choice 'runge_kutta'");
+  refused(rhexis, "capsule.preconditioner", "multigrid", "unknown choice 'multigrid'");
+  refused(rhexis, "capsule.cg_tolerance", "1.5", "expected a number in (0, 1)");
+  refused(rhexis, "capsule.cg_tolerance", "tight", "expected a number in (0, 1)");
+  refused(rhexis, "tools.ports", "always", "unknown choice 'always'");
+  Scenario ok = rhexis;
+  ok.methods["capsule.cg_tolerance"] = "1e-8";
+  ok.methods["capsule.preconditioner"] = "two_level";
+  EXPECT_NO_THROW(check_scene_inputs(ok));
+  // Every choice the table lists is one the scene takes (the table and the systems agree).
+  for (const MethodSetting& m : method_settings()) {
+    if (m.key.rfind("capsule.", 0) != 0) continue;
+    for (std::string_view c : m.choices) {
+      Scenario each = rhexis;
+      each.methods[std::string(m.key)] = std::string(c);
+      EXPECT_NO_THROW(check_scene_inputs(each)) << m.key << " = " << c;
+    }
+  }
 }
 
 TEST(Run, ReportHasEveryRequiredField) {
