@@ -1,3 +1,5 @@
+// One file for now: codec, CRC, seqlock, sockets and the I/O thread of one device; issue 22 splits
+// the codec from the transport.
 #include "engine/haptics/udp_bridge.hpp"
 
 #include <arpa/inet.h>

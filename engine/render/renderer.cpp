@@ -1,3 +1,4 @@
+// One file for now: the passes share one GL state and its slots; issue 22 splits them by job.
 // The microscope view (renderer.hpp). Per view (one, or two for side-by-side stereo) the passes
 // are:
 //   1. opaque tissue: sclera, iris, lens surface (red reflex), exposed nucleus

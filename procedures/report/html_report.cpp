@@ -1,3 +1,4 @@
+// One file for now: the page, its tables and its inline SVG plots; issue 22 splits it by job.
 #include "procedures/report/html_report.hpp"
 
 #include "engine/core/markup.hpp"

@@ -18,14 +18,17 @@ double net_force_sq(const SpringGraph& g, const WakeInputs& w, uint32_t p) {
   const Particles& x = *w.particles;
   const Springs& s = *w.springs;
   double fx = 0.0, fy = 0.0, fz = 0.0;
-  if (w.external && p < w.external->fx.size()) fx = w.external->fx[p], fy = w.external->fy[p], fz = w.external->fz[p];
+  if (w.external && p < w.external->fx.size())
+    fx = w.external->fx[p], fy = w.external->fy[p], fz = w.external->fz[p];
   for (uint32_t k = g.begin(p); k < g.end(p); ++k) {
     const uint32_t q = g.neighbour[k], e = g.spring[k];
-    const double dx = double(x.x[q]) - x.x[p], dy = double(x.y[q]) - x.y[p], dz = double(x.z[q]) - x.z[p];
+    const double dx = double(x.x[q]) - x.x[p], dy = double(x.y[q]) - x.y[p],
+                 dz = double(x.z[q]) - x.z[p];
     const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
     if (l <= 0.0) continue;
     const double ext = l - s.rest_length[e];
-    const double mag = w.law == SpringLaw::Linear ? s.stiffness[e] * ext : s.stiffness[e] * ext * std::fabs(ext);
+    const double mag =
+        w.law == SpringLaw::Linear ? s.stiffness[e] * ext : s.stiffness[e] * ext * std::fabs(ext);
     fx += mag * dx / l, fy += mag * dy / l, fz += mag * dz / l;
   }
   return fx * fx + fy * fy + fz * fz;
@@ -98,14 +101,16 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
     set.particles.push_back(q);
   };
   for (uint32_t p : set.previous_list) {
-    const bool moved = wake.particles && speed_sq(*wake.particles, p) * wake.dt_s * wake.dt_s > motion_sq;
+    const bool moved =
+        wake.particles && speed_sq(*wake.particles, p) * wake.dt_s * wake.dt_s > motion_sq;
     const bool loaded = force_rule && net_force_sq(graph, wake, p) > load_sq;
     if (moved || loaded) activate(p);
     for (uint32_t k = graph.begin(p); k < graph.end(p); ++k) {
       const uint32_t q = graph.neighbour[k];
       if (moved) {
         activate(q);
-      } else if (force_rule && !set.previous[q] && !set.mark[q] && net_force_sq(graph, wake, q) > load_sq) {
+      } else if (force_rule && !set.previous[q] && !set.mark[q] &&
+                 net_force_sq(graph, wake, q) > load_sq) {
         activate(q);  // sleeping frontier loaded by an active neighbour's springs
       }
     }

@@ -51,13 +51,14 @@ struct WakeInputs {
 };
 
 struct ActiveSet {
-  std::vector<uint32_t> particles;    // sorted; feeds Membrane::active
-  std::vector<uint32_t> springs;      // sorted; springs with at least one active end; Membrane::active_springs
+  std::vector<uint32_t> particles;  // sorted; feeds Membrane::active
+  std::vector<uint32_t>
+      springs;  // sorted; springs with at least one active end; Membrane::active_springs
   std::vector<uint32_t> fell_asleep;  // sorted; active last update, asleep now
   uint32_t woken = 0;                 // particles active only through the wake rules this update
   // Scratch, sized to the particle count once; cleared through the lists above.
-  std::vector<uint8_t> mark;          // 1 = active
-  std::vector<uint8_t> previous;      // 1 = was active at the last update
+  std::vector<uint8_t> mark;      // 1 = active
+  std::vector<uint8_t> previous;  // 1 = was active at the last update
   std::vector<uint32_t> queue, hops, spring_scratch, previous_list;
 };
 

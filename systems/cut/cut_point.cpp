@@ -64,7 +64,6 @@ Closest closest_on(const Particles& p, const Triangles& tr, uint32_t t, const Ve
                              particle_position(p, tr.c[t]));
 }
 
-
 uint32_t scan_nearest(const Particles& p, const Triangles& tr, const Vec3& point) {
   uint32_t best = kInvalidIndex;
   double best_d = std::numeric_limits<double>::infinity();

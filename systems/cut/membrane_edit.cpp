@@ -13,7 +13,8 @@ constexpr double kPi = 3.14159265358979323846;
 void ensure_sizes(CutMesh& m) {
   MembraneTopology& g = m.topology;
   const size_t nt = m.triangles.slots.size(), np = m.particles.slots.size();
-  if (g.adjacency.neighbour.size() < nt) g.adjacency.neighbour.resize(nt, {kInvalidIndex, kInvalidIndex, kInvalidIndex});
+  if (g.adjacency.neighbour.size() < nt)
+    g.adjacency.neighbour.resize(nt, {kInvalidIndex, kInvalidIndex, kInvalidIndex});
   if (g.vertex_triangle.size() < np) {
     g.vertex_triangle.resize(np, kInvalidIndex);
     g.rest_x.resize(np, 0.0);
@@ -31,7 +32,9 @@ int edge_slot(const Triangles& tr, uint32_t t, uint32_t u, uint32_t v) {
   return -1;
 }
 
-void set_corner(Triangles& tr, uint32_t t, int k, uint32_t v) { (k == 0 ? tr.a : (k == 1 ? tr.b : tr.c))[t] = v; }
+void set_corner(Triangles& tr, uint32_t t, int k, uint32_t v) {
+  (k == 0 ? tr.a : (k == 1 ? tr.b : tr.c))[t] = v;
+}
 
 void set_link(CutMesh& m, uint32_t t, uint32_t u, uint32_t v, uint32_t n) {
   if (t == kInvalidIndex) return;
@@ -62,16 +65,19 @@ uint32_t add_particle(CutMesh& m, uint32_t from, uint32_t other, double w) {
   MembraneTopology& g = m.topology;
   const auto mix = [&](auto& col) {
     using T = std::decay_t<decltype(col[0])>;
-    col[v] = other == kInvalidIndex ? col[from] : static_cast<T>((1.0 - w) * col[from] + w * col[other]);
+    col[v] =
+        other == kInvalidIndex ? col[from] : static_cast<T>((1.0 - w) * col[from] + w * col[other]);
   };
   mix(p.x), mix(p.y), mix(p.z), mix(p.vx), mix(p.vy), mix(p.vz), mix(p.inv_mass);
   mix(g.rest_x), mix(g.rest_y), mix(g.rest_z);
   if (other == kInvalidIndex) {
     p.kind[v] = p.kind[from];
   } else {
-    const bool anchored = p.kind[from] == ParticleKind::Anchored && p.kind[other] == ParticleKind::Anchored;
+    const bool anchored =
+        p.kind[from] == ParticleKind::Anchored && p.kind[other] == ParticleKind::Anchored;
     p.kind[v] = anchored ? ParticleKind::Anchored : ParticleKind::Free;
-    if (!anchored && p.inv_mass[v] == 0.0f) p.inv_mass[v] = std::max(p.inv_mass[from], p.inv_mass[other]);
+    if (!anchored && p.inv_mass[v] == 0.0f)
+      p.inv_mass[v] = std::max(p.inv_mass[from], p.inv_mass[other]);
     if (anchored) p.inv_mass[v] = 0.0f;
   }
   g.vertex_triangle[v] = kInvalidIndex;
@@ -102,7 +108,8 @@ void remove_spring(CutMesh& m, uint32_t a, uint32_t b) {
 }
 
 double rest_area(const CutMesh& m, uint32_t t) {
-  const Vec3 a = rest_position(m.topology, m.triangles.a[t]), b = rest_position(m.topology, m.triangles.b[t]),
+  const Vec3 a = rest_position(m.topology, m.triangles.a[t]),
+             b = rest_position(m.topology, m.triangles.b[t]),
              c = rest_position(m.topology, m.triangles.c[t]);
   return 0.5 * (b - a).cross(c - a).norm();
 }
@@ -112,7 +119,8 @@ void push_unique(std::vector<uint32_t>& v, uint32_t x) {
 }
 
 // Neighbours of v over the given triangles (the corners that are not v).
-void neighbours_over(const Triangles& tr, const std::vector<uint32_t>& tris, uint32_t v, std::vector<uint32_t>& out) {
+void neighbours_over(const Triangles& tr, const std::vector<uint32_t>& tris, uint32_t v,
+                     std::vector<uint32_t>& out) {
   out.clear();
   for (uint32_t t : tris) {
     for (int k = 0; k < 3; ++k) {
@@ -124,13 +132,15 @@ void neighbours_over(const Triangles& tr, const std::vector<uint32_t>& tris, uin
 
 // Gives every connected component of v's triangles (found from the candidates) but the first its
 // own copy of v, moving or splitting v's springs to match.
-void separate_wedges(CutMesh& m, uint32_t v, const std::vector<uint32_t>& candidates, EditLog& log) {
+void separate_wedges(CutMesh& m, uint32_t v, const std::vector<uint32_t>& candidates,
+                     EditLog& log) {
   std::vector<std::vector<uint32_t>> components;
   std::vector<uint32_t> fan;
   for (uint32_t c : candidates) {
     if (!m.triangles.slots.alive(c) || corner_slot(m.triangles, c, v) < 0) continue;
     bool seen = false;
-    for (const auto& comp : components) seen = seen || std::find(comp.begin(), comp.end(), c) != comp.end();
+    for (const auto& comp : components)
+      seen = seen || std::find(comp.begin(), comp.end(), c) != comp.end();
     if (seen) continue;
     vertex_fan(m.triangles, m.topology.adjacency, c, v, fan);
     components.push_back(fan);
@@ -142,7 +152,8 @@ void separate_wedges(CutMesh& m, uint32_t v, const std::vector<uint32_t>& candid
   for (size_t i = 1; i < components.size(); ++i) {
     const uint32_t copy = add_particle(m, v, kInvalidIndex, 0.0);
     neighbours_over(m.triangles, components[i], v, moved);
-    for (uint32_t t : components[i]) set_corner(m.triangles, t, corner_slot(m.triangles, t, v), copy);
+    for (uint32_t t : components[i])
+      set_corner(m.triangles, t, corner_slot(m.triangles, t, v), copy);
     still.clear();
     for (size_t j = 0; j < components.size(); ++j)
       if (j == 0 || j > i) still.insert(still.end(), components[j].begin(), components[j].end());
@@ -168,17 +179,33 @@ double angle_deg(const Vec3& u, const Vec3& w) {
 
 // Shared with the other edit files of this folder (systems/cut/edit_detail.hpp).
 namespace detail {
-int edge_slot(const Triangles& tr, uint32_t t, uint32_t u, uint32_t v) { return cut::edge_slot(tr, t, u, v); }
-void set_link(CutMesh& m, uint32_t t, uint32_t u, uint32_t v, uint32_t n) { cut::set_link(m, t, u, v, n); }
-uint32_t link_across(const CutMesh& m, uint32_t t, uint32_t u, uint32_t v) { return cut::link_across(m, t, u, v); }
-void add_spring(CutMesh& m, uint32_t a, uint32_t b) { cut::add_spring(m, a, b); }
-void remove_spring(CutMesh& m, uint32_t a, uint32_t b) { cut::remove_spring(m, a, b); }
-void push_unique(std::vector<uint32_t>& v, uint32_t x) { cut::push_unique(v, x); }
+int edge_slot(const Triangles& tr, uint32_t t, uint32_t u, uint32_t v) {
+  return cut::edge_slot(tr, t, u, v);
+}
+void set_link(CutMesh& m, uint32_t t, uint32_t u, uint32_t v, uint32_t n) {
+  cut::set_link(m, t, u, v, n);
+}
+uint32_t link_across(const CutMesh& m, uint32_t t, uint32_t u, uint32_t v) {
+  return cut::link_across(m, t, u, v);
+}
+void add_spring(CutMesh& m, uint32_t a, uint32_t b) {
+  cut::add_spring(m, a, b);
+}
+void remove_spring(CutMesh& m, uint32_t a, uint32_t b) {
+  cut::remove_spring(m, a, b);
+}
+void push_unique(std::vector<uint32_t>& v, uint32_t x) {
+  cut::push_unique(v, x);
+}
 }  // namespace detail
 
-void EditLog::clear() { *this = EditLog{}; }
+void EditLog::clear() {
+  *this = EditLog{};
+}
 
-Vec3 rest_position(const MembraneTopology& g, uint32_t v) { return {g.rest_x[v], g.rest_y[v], g.rest_z[v]}; }
+Vec3 rest_position(const MembraneTopology& g, uint32_t v) {
+  return {g.rest_x[v], g.rest_y[v], g.rest_z[v]};
+}
 
 double min_angle_deg(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
   const Vec3 e01 = p1 - p0, e12 = p2 - p1, e20 = p0 - p2;
@@ -209,15 +236,16 @@ MembraneTopology build_topology(const Particles& p, const Triangles& tr, const S
       const uint32_t v = corner(tr, t, k), w = corner(tr, t, (k + 1) % 3);
       if (g.vertex_triangle[v] == kInvalidIndex) g.vertex_triangle[v] = t;
       if (!g.spring_of_edge.count(edge_key(v, w)))
-        throw std::invalid_argument("cut: edge (" + std::to_string(v) + ", " + std::to_string(w) + ") of triangle " +
-                                    std::to_string(t) + " has no spring");
+        throw std::invalid_argument("cut: edge (" + std::to_string(v) + ", " + std::to_string(w) +
+                                    ") of triangle " + std::to_string(t) + " has no spring");
     }
   }
   return g;
 }
 
 void reserve_for_cuts(CutMesh& m, uint32_t extra) {
-  const size_t np = m.particles.slots.size() + extra, nt = m.triangles.slots.size() + 2 * size_t{extra},
+  const size_t np = m.particles.slots.size() + extra,
+               nt = m.triangles.slots.size() + 2 * size_t{extra},
                ns = m.springs.slots.size() + 3 * size_t{extra};
   m.particles.slots.reserve(static_cast<uint32_t>(np));
   m.triangles.slots.reserve(static_cast<uint32_t>(nt));
@@ -308,13 +336,15 @@ uint32_t split_edge(CutMesh& m, uint32_t a, uint32_t b, double t, EditLog& log) 
   log.origins.push_back({q, {a, b, kInvalidIndex}, {1.0 - t, t, 0.0}});
   log.touched_triangles.insert(log.touched_triangles.end(), all.begin(), all.end());
   ++log.edge_splits;
-  if (!linked && tris.size() == 2) separate_wedges(m, q, all, log);  // a slit grows an inner point: it opens
+  if (!linked && tris.size() == 2)
+    separate_wedges(m, q, all, log);  // a slit grows an inner point: it opens
   return q;
 }
 
 uint32_t split_face(CutMesh& m, uint32_t tri, const Vec3& bary, EditLog& log) {
   if (!m.triangles.slots.alive(tri) || !bary.allFinite())
-    throw std::invalid_argument("split_face: triangle " + std::to_string(tri) + " is dead or the weights are not finite");
+    throw std::invalid_argument("split_face: triangle " + std::to_string(tri) +
+                                " is dead or the weights are not finite");
   Triangles& tr = m.triangles;
   const uint32_t a = tr.a[tri], b = tr.b[tri], c = tr.c[tri];
   const Vec3 w = bary.cwiseMax(0.0) / bary.cwiseMax(0.0).sum();
@@ -330,10 +360,12 @@ uint32_t split_face(CutMesh& m, uint32_t tri, const Vec3& bary, EditLog& log) {
     };
     blend(p.x), blend(p.y), blend(p.z), blend(p.vx), blend(p.vy), blend(p.vz);
     blend(g.rest_x), blend(g.rest_y), blend(g.rest_z);
-    const bool anchored = p.kind[a] == ParticleKind::Anchored && p.kind[b] == ParticleKind::Anchored &&
+    const bool anchored = p.kind[a] == ParticleKind::Anchored &&
+                          p.kind[b] == ParticleKind::Anchored &&
                           p.kind[c] == ParticleKind::Anchored;
     p.kind[q] = anchored ? ParticleKind::Anchored : ParticleKind::Free;
-    p.inv_mass[q] = anchored ? 0.0f : std::max({p.inv_mass[a], p.inv_mass[b], p.inv_mass[c], p.inv_mass[q]});
+    p.inv_mass[q] =
+        anchored ? 0.0f : std::max({p.inv_mass[a], p.inv_mass[b], p.inv_mass[c], p.inv_mass[q]});
   }
   auto& nb = m.topology.adjacency.neighbour;
   const uint32_t nb_bc = nb[tri][1], nb_ca = nb[tri][2];
@@ -394,15 +426,18 @@ bool merge_along_cut(CutMesh& m, uint32_t v, double max_turn_deg, double min_ang
   if (next_of(A, 2) != next_of(B, 1)) return false;
   const uint32_t x = next_of(A, 2), m2 = next_of(A, 1), m1 = next_of(B, 2);
   if (m1 == m2 || link_across(m, A, v, x) != B) return false;
-  if (link_across(m, A, v, m2) != kInvalidIndex || link_across(m, B, m1, v) != kInvalidIndex) return false;
+  if (link_across(m, A, v, m2) != kInvalidIndex || link_across(m, B, m1, v) != kInvalidIndex)
+    return false;
   if (m.topology.spring_of_edge.count(edge_key(m1, m2))) return false;
   const auto pos = [&](uint32_t i) { return cut::particle_position(p, i); };
   if (angle_deg(pos(v) - pos(m1), pos(m2) - pos(v)) >= max_turn_deg) return false;
   const auto rest = [&](uint32_t i) { return rest_position(m.topology, i); };
   if (angle_deg(rest(v) - rest(m1), rest(m2) - rest(v)) >= max_turn_deg) return false;
-  if (min_angle_deg(pos(m2), pos(x), pos(m1)) < min_angle || min_angle_deg(rest(m2), rest(x), rest(m1)) < min_angle)
+  if (min_angle_deg(pos(m2), pos(x), pos(m1)) < min_angle ||
+      min_angle_deg(rest(m2), rest(x), rest(m1)) < min_angle)
     return false;
-  const Vec3 nA = (pos(m2) - pos(v)).cross(pos(x) - pos(v)), nB = (pos(x) - pos(v)).cross(pos(m1) - pos(v));
+  const Vec3 nA = (pos(m2) - pos(v)).cross(pos(x) - pos(v)),
+             nB = (pos(x) - pos(v)).cross(pos(m1) - pos(v));
   const Vec3 nC = (pos(x) - pos(m2)).cross(pos(m1) - pos(m2));
   if (nC.dot(nA + nB) <= 0.0) return false;
 
@@ -416,7 +451,8 @@ bool merge_along_cut(CutMesh& m, uint32_t v, double max_turn_deg, double min_ang
   add_spring(m, m1, m2);
   table_remove(p, v);
   m.topology.vertex_triangle[v] = kInvalidIndex;
-  m.topology.vertex_triangle[m1] = m.topology.vertex_triangle[m2] = m.topology.vertex_triangle[x] = A;
+  m.topology.vertex_triangle[m1] = m.topology.vertex_triangle[m2] = m.topology.vertex_triangle[x] =
+      A;
   log.removed_particles.push_back(v);
   log.touched_triangles.push_back(A);
   ++log.merges;
@@ -437,8 +473,9 @@ std::string check_topology(const CutMesh& m) {
       const uint32_t u = corner(tr, t, k), v = corner(tr, t, (k + 1) % 3);
       if (n != kInvalidIndex) {
         if (n != fresh.neighbour[t][k])
-          return "triangle " + std::to_string(t) + " edge " + std::to_string(k) + " links " + std::to_string(n) +
-                 ", a fresh adjacency says " + std::to_string(fresh.neighbour[t][k]);
+          return "triangle " + std::to_string(t) + " edge " + std::to_string(k) + " links " +
+                 std::to_string(n) + ", a fresh adjacency says " +
+                 std::to_string(fresh.neighbour[t][k]);
         if (edge_slot(tr, n, u, v) < 0 || g.adjacency.neighbour[n][edge_slot(tr, n, u, v)] != t)
           return "link " + std::to_string(t) + " -> " + std::to_string(n) + " is not mutual";
       }
@@ -450,12 +487,14 @@ std::string check_topology(const CutMesh& m) {
     if (!m.particles.slots.alive(v) || g.vertex_triangle[v] == kInvalidIndex) continue;
     const uint32_t h = g.vertex_triangle[v];
     if (!tr.slots.alive(h) || corner_slot(tr, h, v) < 0)
-      return "particle " + std::to_string(v) + "'s hint triangle " + std::to_string(h) + " does not hold it";
+      return "particle " + std::to_string(v) + "'s hint triangle " + std::to_string(h) +
+             " does not hold it";
   }
   size_t live = 0;
   for (uint32_t e = 0; e < m.springs.slots.size(); ++e) live += m.springs.slots.alive(e);
   if (live != g.spring_of_edge.size())
-    return std::to_string(live) + " live springs but " + std::to_string(g.spring_of_edge.size()) + " indexed";
+    return std::to_string(live) + " live springs but " + std::to_string(g.spring_of_edge.size()) +
+           " indexed";
   for (const auto& [key, e] : g.spring_of_edge) {
     if (!m.springs.slots.alive(e) || edge_key(m.springs.i[e], m.springs.j[e]) != key)
       return "spring index names spring " + std::to_string(e) + " for another pair";
@@ -474,7 +513,8 @@ void refresh_region(CutMesh& m, EditLog& log) {
       const uint32_t u = corner(tr, t, k), w = corner(tr, t, (k + 1) % 3);
       push_unique(corners, u);
       const auto it = m.topology.spring_of_edge.find(edge_key(u, w));
-      if (it == m.topology.spring_of_edge.end()) throw std::logic_error("refresh_region: an edge lost its spring");
+      if (it == m.topology.spring_of_edge.end())
+        throw std::logic_error("refresh_region: an edge lost its spring");
       triangles_on_edge(m, u, w, on_edge);
       double area = 0.0, half_cot = 0.0;
       for (uint32_t e : on_edge) {
@@ -487,7 +527,8 @@ void refresh_region(CutMesh& m, EditLog& log) {
         half_cot += cross > 0 ? 0.5 * du.dot(dw) / cross : 0.0;
       }
       const double length = (rest_position(m.topology, u) - rest_position(m.topology, w)).norm();
-      const springs::SpringConstants sc = springs::edge_spring_constants(m.material.springs, length, area, half_cot);
+      const springs::SpringConstants sc =
+          springs::edge_spring_constants(m.material.springs, length, area, half_cot);
       log.clamped_pretension += sc.pretension_clamped;
       m.springs.stiffness[it->second] = static_cast<float>(sc.stiffness);
       m.springs.rest_length[it->second] = static_cast<float>(sc.rest_length);

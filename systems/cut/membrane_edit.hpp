@@ -43,8 +43,8 @@ namespace phaco::cut {
 
 // What the edits keep consistent beside the tables.
 struct MembraneTopology {
-  TriangleAdjacency adjacency;                            // per triangle slot
-  std::vector<uint32_t> vertex_triangle;                  // per particle slot: an alive triangle holding it
+  TriangleAdjacency adjacency;            // per triangle slot
+  std::vector<uint32_t> vertex_triangle;  // per particle slot: an alive triangle holding it
   std::unordered_map<uint64_t, uint32_t> spring_of_edge;  // edge_key(i, j) -> spring
   std::vector<double> rest_x, rest_y, rest_z;             // per particle slot: rest shape, mm
   // Springs the edits added and removed since the owner of the physics last caught up (it clears
@@ -60,7 +60,8 @@ inline uint64_t edge_key(uint32_t i, uint32_t j) {
 
 struct MembraneMaterial {
   springs::SpringMaterial springs;
-  double areal_density_kg_mm2 = 0.0;  // ρ·h; masses lumped as ρ·h·area/3 per corner; 0: masses untouched
+  double areal_density_kg_mm2 =
+      0.0;  // ρ·h; masses lumped as ρ·h·area/3 per corner; 0: masses untouched
 };
 
 // The tables an edit changes, together.
@@ -96,7 +97,8 @@ struct EditLog {
 // Builds the topology of a membrane whose rest shape is its current shape. Throws
 // std::invalid_argument when the springs are not the edge set (check_membrane first) or a
 // triangle is invalid.
-MembraneTopology build_topology(const Particles& particles, const Triangles& triangles, const Springs& springs);
+MembraneTopology build_topology(const Particles& particles, const Triangles& triangles,
+                                const Springs& springs);
 
 // Alive triangles holding both a and b (one or two; more only on a broken mesh), sorted.
 void triangles_on_edge(const CutMesh& m, uint32_t a, uint32_t b, std::vector<uint32_t>& out);
@@ -130,7 +132,8 @@ bool open_edge(CutMesh& m, uint32_t p, uint32_t q, EditLog& log);
 // with both (m1, v) and (v, m2) on the boundary and turning by less than max_turn_deg, and the
 // merged triangle (m1, m2, x) keeps its orientation and every angle at least min_angle_deg, they
 // merge and v is removed. Anchored or scripted particles are never removed. Returns true if merged.
-bool merge_along_cut(CutMesh& m, uint32_t v, double max_turn_deg, double min_angle_deg, EditLog& log);
+bool merge_along_cut(CutMesh& m, uint32_t v, double max_turn_deg, double min_angle_deg,
+                     EditLog& log);
 
 // Recomputes stiffness and rest length of every spring on an edge of a touched triangle, and the
 // masses of their corners (anchored particles keep inverse mass 0). Call after a batch of edits.

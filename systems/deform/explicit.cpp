@@ -131,7 +131,8 @@ Motion euler_step(Membrane& m, double dt_s) {
               inv_scale = inverse_mass_scale(m.dynamics);
   Motion motion = for_each_in_play(particles_in_play(m), [&](uint32_t i, ChunkMotion& local) {
     const float w = integrating_inv_mass(p, i, inv_scale);
-    const float h = w > 0.0f ? dt : 0.0f;  // scripted particles keep their imposed velocity and stay put
+    const float h =
+        w > 0.0f ? dt : 0.0f;  // scripted particles keep their imposed velocity and stay put
     if constexpr (!kSymplectic) p.x[i] += h * p.vx[i], p.y[i] += h * p.vy[i], p.z[i] += h * p.vz[i];
     p.vx[i] += dt * w * f.fx[i], p.vy[i] += dt * w * f.fy[i], p.vz[i] += dt * w * f.fz[i];
     if constexpr (kSymplectic) p.x[i] += h * p.vx[i], p.y[i] += h * p.vy[i], p.z[i] += h * p.vz[i];
@@ -143,9 +144,13 @@ Motion euler_step(Membrane& m, double dt_s) {
 
 }  // namespace
 
-Motion explicit_euler_step(Membrane& m, double dt_s) { return euler_step<false>(m, dt_s); }
+Motion explicit_euler_step(Membrane& m, double dt_s) {
+  return euler_step<false>(m, dt_s);
+}
 
-Motion symplectic_euler_step(Membrane& m, double dt_s) { return euler_step<true>(m, dt_s); }
+Motion symplectic_euler_step(Membrane& m, double dt_s) {
+  return euler_step<true>(m, dt_s);
+}
 
 Motion semi_implicit_001_step(Membrane& m, double dt_s, std::vector<float>& kappa) {
   const uint32_t rejected = compute_forces(m);

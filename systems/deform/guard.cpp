@@ -133,7 +133,8 @@ uint32_t sanitize_and_save(Membrane& m, Snapshot& snap) {
   Particles& p = m.particles;
   const uint32_t n = p.slots.size();
   uint32_t repaired = 0;
-  if (snap.x.size() > n || snap.x.empty()) {  // first use: repair against nothing, copy every particle
+  if (snap.x.size() > n ||
+      snap.x.empty()) {  // first use: repair against nothing, copy every particle
     for (uint32_t i = 0; i < n; ++i) repaired += repair(m, snap, i) ? 1 : 0;
     snap.x = p.x, snap.y = p.y, snap.z = p.z, snap.vx = p.vx, snap.vy = p.vy, snap.vz = p.vz;
     return repaired;
