@@ -13,12 +13,19 @@ packages=(
   libtet1.5-dev          # TetGen (lens tetrahedralisation)
   nlohmann-json3-dev     # scenario / report JSON
   libsqlite3-dev         # session records
+  libpq-dev              # a training centre's records on PostgreSQL (issue 21)
+  postgresql             # the throwaway server the records tests run against (scripts/test.sh)
   libgtest-dev libgmock-dev
   libbenchmark-dev       # Google Benchmark
   libglfw3-dev libepoxy-dev libimgui-dev   # trainer (later issues)
   xvfb mesa-utils libgl1-mesa-dri   # renderer tests: a virtual X display, Mesa's llvmpipe
   chromium               # headless check of the HTML report
 )
+
+# Node.js and npm run the xAPI validator of the records tests (an npm package, issue 21). A
+# machine that has them from elsewhere (NodeSource's nodejs bundles npm) keeps its own: Debian's
+# npm package would conflict with it.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
 
 missing=()
 for p in "${packages[@]}"; do

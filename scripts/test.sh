@@ -12,6 +12,20 @@ jobs="${PHACO_JOBS:-$(nproc)}"
 
 build="$root/build/release"
 PHACO_BUILD_DIR="$build" "$root/scripts/build.sh"
+# The xAPI validator the records tests run (issue 21): Learning Locker's, from npm, at the
+# version tests/tools/xapi/package-lock.json pins, installed into the build tree.
+mkdir -p "$build/xapi-validator"
+cp "$root/tests/tools/xapi/package.json" "$root/tests/tools/xapi/package-lock.json" \
+  "$root/tests/tools/xapi/validate.js" "$build/xapi-validator/"
+(cd "$build/xapi-validator" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+export PHACO_XAPI_VALIDATOR="$build/xapi-validator/validate.js"
+# A throwaway PostgreSQL server for the records tests (issue 21): its own folder, a Unix socket
+# there, removed when this script ends, pass or fail (scripts/pg_test_cluster.sh).
+pg_dir="$(mktemp -d "${TMPDIR:-/tmp}/phaco-pg.XXXXXX")"
+rmdir "$pg_dir"
+trap '"$root/scripts/pg_test_cluster.sh" remove "$pg_dir"' EXIT
+eval "$("$root/scripts/pg_test_cluster.sh" start "$pg_dir")"
+export PHACO_TEST_PG_URI PHACO_TEST_PG_DIR PHACO_TEST_PG_CTL
 # Tests build their meshes into a cache inside the build tree, never into the user's home.
 export PHACO_CACHE_DIR="$build/mesh-cache"
 # A test that needs an X server, GL or xvfb-run fails here instead of skipping: this run must not

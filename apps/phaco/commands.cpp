@@ -15,6 +15,7 @@
 #include "engine/core/utc_time.hpp"
 #include "engine/haptics/device_factory.hpp"
 #include "engine/io/scenario.hpp"
+#include "engine/records/record_location.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/haptics/realtime_run.hpp"
@@ -223,7 +224,7 @@ int run(const std::vector<std::string>& raw) {
   if (db) {
     const int64_t id = record_run(*db, *trainee, scenario, j);
     std::fprintf(stderr, "recorded as record %lld in %s\n", static_cast<long long>(id),
-                 db->c_str());
+                 shown_location(db->string()).c_str());
   }
   if (a.flag("--json")) {
     std::printf("%s\n", j.dump(2).c_str());

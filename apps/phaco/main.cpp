@@ -4,10 +4,12 @@
 #include <string>
 #include <vector>
 
+#include "apps/phaco/cohort_command.hpp"
 #include "apps/phaco/commands.hpp"
 #include "apps/phaco/compare_command.hpp"
 #include "apps/phaco/records_commands.hpp"
 #include "apps/phaco/report_command.hpp"
+#include "apps/phaco/sync_command.hpp"
 #include "engine/core/error.hpp"
 
 namespace {
@@ -20,7 +22,8 @@ usage:
       Run a scenario headless for its duration at its fixed step; print a summary with the
       drill's metrics and 0-100 score (docs/scoring.md), or, with --json, the JSON report; write
       the JSON report to OUT.json; with --trainee, store the run in the records database
-      (DB, default $PHACO_RECORDS_DB or ~/.local/share/openphaco/records.sqlite; docs/records.md).
+      (DB, default $PHACO_DB or ~/.local/share/openphaco/records.sqlite; docs/records.md).
+      Any DB may be an SQLite file or a postgresql:// URI (a training centre's server).
       --difficulty picks a level of the drill file (data/drills/<drill>.json, e.g. standard,
       easy, hard; docs/drills.md) instead of the scenario's.
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
@@ -53,10 +56,24 @@ usage:
       Compare a run report with an expert's: per hand, path distance, speed and force differences
       after dynamic time warping of the tool paths, the time ratio, and run - expert per metric
       (docs/compare.md).
+  phaco sync --to URI [--db FILE] [--all] [--batch N] [--json]
+      Upload this station's records (its SQLite file, --db or the default) to a training
+      centre's PostgreSQL server (URI postgresql://USER[:PASSWORD]@HOST[:PORT]/DB, or
+      $PHACO_SYNC_TO; a password may also come from PGPASSFILE or PGPASSWORD and is never
+      printed). Only what the centre has not acknowledged is sent (--all: everything again); the
+      centre keeps each record once, so an interrupted or repeated sync loses and duplicates
+      nothing (docs/records.md). Exit 3 when the centre refused some records.
+  phaco cohort --html OUT.html [--db DB] [--title T] [--drill NAME]
+      A training centre's cohort on one self-contained page: every trainee's learning curve per
+      drill with the pass line, the pass rates, and each trainee's weakest metrics.
   phaco history TRAINEE [--db DB] [--json]
       The trainee's recorded sessions in date order (drill, score, key metrics) and the trend.
   phaco export ID [--db DB] [--xml OUT] [--json OUT] [--scenario OUT]
       One record as XML (seed 000 §6.4), JSON, or the scenario that replays it with phaco run.
+  phaco export [ID] --xapi OUT.json [--db DB] [--trainee NAME] [--home-page IRI]
+      Finished drills (one, the trainee's, or all) as xAPI 2.0 statements for a learning
+      management system: score, success, duration and every metric with its unit; the
+      statement id is the record's uuid (docs/records.md, "xAPI").
   phaco graph FILE [--out OUT.dot]
       Print the scenario's per-frame task graph as GraphViz DOT.
   phaco --help | --version
@@ -99,6 +116,8 @@ int main(int argc, char** argv) {
     if (command == "compare") return phaco::cli::compare(args);
     if (command == "history") return phaco::cli::history(args);
     if (command == "export") return phaco::cli::export_record(args);
+    if (command == "sync") return phaco::cli::sync(args);
+    if (command == "cohort") return phaco::cli::cohort(args);
     std::fprintf(stderr, "phaco: unknown command '%s' (try 'phaco --help')\n", command.c_str());
     return phaco::cli::kBadInput;
   } catch (const phaco::InputError& e) {

@@ -12,6 +12,7 @@
 #include "apps/phaco/commands.hpp"
 #include "engine/core/error.hpp"
 #include "engine/records/records.hpp"
+#include "engine/records/xapi.hpp"
 
 namespace phaco::cli {
 
@@ -109,13 +110,13 @@ int history(const std::vector<std::string>& raw) {
   if (records.empty()) {
     std::string known;
     for (const auto& name : store.trainees()) known += (known.empty() ? "" : ", ") + name;
-    throw InputError("history: no records for trainee '" + trainee + "' in " + db.string() +
+    throw InputError("history: no records for trainee '" + trainee + "' in " + store.location() +
                      (known.empty() ? " (it holds no records)" : " (trainees: " + known + ")"));
   }
   const auto by_drill = trends(records);
 
   if (a.flag("--json")) {
-    json out = {{"trainee", trainee}, {"db", db.string()}};
+    json out = {{"trainee", trainee}, {"db", store.location()}};
     json rows = json::array();
     for (const SessionRecord& r : records) {
       json keys = json::object();
@@ -148,7 +149,7 @@ int history(const std::vector<std::string>& raw) {
   }
 
   std::printf("trainee %s: %zu session(s) in %s\n", trainee.c_str(), records.size(),
-              db.string().c_str());
+              store.location().c_str());
   std::printf("  %5s  %-19s  %-16s  %5s  %s\n", "id", "date (UTC)", "drill", "score",
               "key metrics");
   for (const SessionRecord& r : records) {
@@ -174,15 +175,57 @@ int history(const std::vector<std::string>& raw) {
   return kOk;
 }
 
-int export_record(const std::vector<std::string>& raw) {
-  const Args a = parse_args("export", raw, {"--db", "--xml", "--json", "--scenario"}, {});
-  if (a.positional.size() != 1) throw InputError("export: give exactly one record id");
-  const std::string& text = a.positional[0];
-  int64_t id = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
-  if (ec != std::errc{} || end != text.data() + text.size() || id < 1) {
-    throw InputError("export: a record id is a positive integer, got '" + text + "'");
+// `phaco export --xapi OUT.json [--trainee NAME] [--home-page IRI]` without an id: every finished
+// drill (or the trainee's) as xAPI statements, one JSON array (engine/records/xapi.hpp).
+int export_xapi(const Args& a, const std::optional<int64_t>& id) {
+  for (const char* o : {"--xml", "--json", "--scenario"})
+    if (a.option(o)) throw InputError(std::string("export: --xapi cannot go with ") + o);
+  const fs::path db = db_path(a);
+  const RecordStore store(db, OpenMode::ExistingOnly);
+  std::vector<SessionRecord> records;
+  if (id) {
+    auto r = store.record(*id);
+    if (!r)
+      throw InputError("export: no record " + std::to_string(*id) + " in " + store.location());
+    records.push_back(std::move(*r));
+  } else if (auto trainee = a.option("--trainee")) {
+    records = store.records_of(*trainee);
+    if (records.empty())
+      throw InputError("export: no records for trainee '" + *trainee + "' in " + store.location());
+  } else {
+    records = store.all_records();
   }
+  const std::string home = a.option("--home-page").value_or(kXapiDefaultHomePage);
+  if (home.rfind("http://", 0) != 0 && home.rfind("https://", 0) != 0)
+    throw InputError("export: --home-page expects an http(s):// IRI, got '" + home + "'");
+  json out = json::array();
+  for (const SessionRecord& r : records) out.push_back(record_to_xapi(r, home));
+  const std::string path = *a.option("--xapi");
+  write_text(path, out.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
+  std::printf("%zu xAPI statement(s) written to %s\n", records.size(), path.c_str());
+  return kOk;
+}
+
+int export_record(const std::vector<std::string>& raw) {
+  const Args a = parse_args(
+      "export", raw,
+      {"--db", "--xml", "--json", "--scenario", "--xapi", "--trainee", "--home-page"}, {});
+  if (a.positional.size() > 1) throw InputError("export: give at most one record id");
+  std::optional<int64_t> id;
+  if (!a.positional.empty()) {
+    const std::string& text = a.positional[0];
+    int64_t v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc{} || end != text.data() + text.size() || v < 1) {
+      throw InputError("export: a record id is a positive integer, got '" + text + "'");
+    }
+    id = v;
+  }
+  if (a.option("--xapi")) return export_xapi(a, id);
+  for (const char* o : {"--trainee", "--home-page"})
+    if (a.option(o)) throw InputError(std::string("export: ") + o + " goes with --xapi");
+  if (!id) throw InputError("export: give a record id (or --xapi OUT for every record)");
+  const std::string text = std::to_string(*id);
   const auto xml = a.option("--xml");
   const auto js = a.option("--json");
   const auto scen = a.option("--scenario");
@@ -190,20 +233,20 @@ int export_record(const std::vector<std::string>& raw) {
     throw InputError("export: give --xml OUT, --json OUT or --scenario OUT");
   const fs::path db = db_path(a);
   const RecordStore store(db, OpenMode::ExistingOnly);
-  const auto record = store.record(id);
-  if (!record) throw InputError("export: no record " + text + " in " + db.string());
+  const auto record = store.record(*id);
+  if (!record) throw InputError("export: no record " + text + " in " + store.location());
   if (xml) {
     write_text(*xml, records_to_xml({*record}));
-    std::printf("record %lld written as XML to %s\n", static_cast<long long>(id), xml->c_str());
+    std::printf("record %lld written as XML to %s\n", static_cast<long long>(*id), xml->c_str());
   }
   if (js) {
     write_text(*js, record_to_json(*record).dump(2) + "\n");
-    std::printf("record %lld written as JSON to %s\n", static_cast<long long>(id), js->c_str());
+    std::printf("record %lld written as JSON to %s\n", static_cast<long long>(*id), js->c_str());
   }
   if (scen) {
     write_text(*scen, record->recording.dump(2) + "\n");
     std::printf("record %lld written as a scenario to %s (replay: phaco run %s)\n",
-                static_cast<long long>(id), scen->c_str(), scen->c_str());
+                static_cast<long long>(*id), scen->c_str(), scen->c_str());
   }
   return kOk;
 }

@@ -65,10 +65,9 @@ int report(const std::vector<std::string>& args) {
     if (const std::string d = file_date(in); !d.empty()) run["date"] = d;
   }
   // Compared before the page is drawn, so a bad expert file fails with its own name.
-  const std::string compared =
-      expert.empty() ? std::string()
-                     : report::compare_section(compare::compare_reports(
-                           run, compare::read_report(expert), in, expert));
+  const std::string compared = expert.empty() ? std::string()
+                                              : report::compare_section(compare::compare_reports(
+                                                    run, compare::read_report(expert), in, expert));
   std::string html;
   try {
     html = report::html_report(run, compared);

@@ -22,6 +22,8 @@
 #include "apps/trainer/trainer_ui.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
+#include "engine/records/background_sync.hpp"
+#include "engine/records/record_location.hpp"
 #include "engine/records/record_run.hpp"
 #include "engine/render/offscreen.hpp"
 #include "engine/render/renderer.hpp"
@@ -163,6 +165,14 @@ int run_trainer(const TrainerOptions& o) {
     render::Microscope microscope;
     session->start();
     TrainerUi ui(o, config);
+    // Offline-first (issue 21): drills are stored here, then uploaded to the centre in the
+    // background; the worker outlives every drill's session and stops with the window.
+    std::unique_ptr<BackgroundSync> sync;
+    if (!o.sync_to.empty()) {
+      sync = std::make_unique<BackgroundSync>(
+          config.records_db.empty() ? default_records_db() : config.records_db, o.sync_to);
+      ui.set_sync(sync.get());
+    }
     FrameClock frames;
     const int64_t t0 = now_ns();
     const auto wall_s = [&] { return static_cast<double>(now_ns() - t0) * 1e-9; };
@@ -323,9 +333,8 @@ int run_trainer(const TrainerOptions& o) {
       // database first; where that folder is the problem (read-only, full), the temp folder.
       std::vector<std::filesystem::path> dirs;
       try {
-        dirs.push_back(
-            (config.records_db.empty() ? default_records_db() : config.records_db).parent_path() /
-            "unsaved");
+        const auto db = config.records_db.empty() ? default_records_db() : config.records_db;
+        if (!is_postgres_uri(db.string())) dirs.push_back(db.parent_path() / "unsaved");
       } catch (const InputError&) {
       }
       dirs.push_back(std::filesystem::temp_directory_path() / "openphaco-unsaved");

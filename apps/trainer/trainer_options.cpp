@@ -7,6 +7,7 @@
 #include "apps/phaco/args.hpp"
 #include "engine/core/error.hpp"
 #include "engine/io/json_reader.hpp"
+#include "engine/records/record_location.hpp"
 #include "procedures/eye/eye_params.hpp"
 
 namespace phaco::trainer {
@@ -15,6 +16,7 @@ const char* const kUsage = R"(phaco-trainer — OpenPhaco's cataract-surgery tra
 
 usage:
   phaco-trainer [--drill NAME | --scenario FILE] [--difficulty LEVEL] [--trainee NAME] [--db DB]
+                [--sync-to URI]
                 [--left DEVICE] [--right DEVICE] [--size WxH] [--stereo] [--no-guidance]
                 [--duration S] [--threads N] [--cache-dir DIR]
   phaco-trainer ... --screenshot OUT.png [--after SECONDS] [--no-ui]
@@ -32,6 +34,11 @@ usage:
   --duration    simulated seconds before the drill ends (default: the scenario's when every hand
                 plays a script, else 900)
   --trainee     store each finished drill in the records database (phaco history NAME)
+  --db          the records database: this station's SQLite file (default
+                ~/.local/share/openphaco/records.sqlite or $PHACO_DB) or a postgresql:// URI
+  --sync-to     a training centre's PostgreSQL server (postgresql://USER@HOST/DB, or
+                $PHACO_SYNC_TO): drills are stored on this station first, then uploaded in the
+                background; while the centre is unreachable it retries every 30 s (docs/records.md)
   --screenshot  run unattended: save the view after --after simulated seconds (default 5), exit
   --stats       run unattended: after --stats-after wall seconds (default 20) write the render
                 frame rate, the simulation rate and the haptic period as JSON, exit
@@ -77,9 +84,9 @@ std::filesystem::path drill_scenario(const std::string& drill) {
 TrainerOptions parse_options(const std::vector<std::string>& raw) {
   const cli::Args a = cli::parse_args(
       "command line", raw,
-      {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee", "--db", "--size",
-       "--threads", "--cache-dir", "--screenshot", "--after", "--stats", "--stats-after",
-       "--duration", "--timeout", "--soak", "--soak-for"},
+      {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee", "--db",
+       "--sync-to", "--size", "--threads", "--cache-dir", "--screenshot", "--after", "--stats",
+       "--stats-after", "--duration", "--timeout", "--soak", "--soak-for"},
       {"--stereo", "--no-guidance", "--no-ui", "--no-render"}, "phaco-trainer --help");
   if (!a.positional.empty()) {
     throw InputError("unexpected argument '" + a.positional[0] +
@@ -97,6 +104,16 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   if (auto v = a.option("--right")) o.right = *v;
   if (auto v = a.option("--trainee")) o.trainee = *v;
   if (auto v = a.option("--db")) o.db = *v;
+  if (auto v = a.option("--sync-to")) {
+    o.sync_to = *v;
+  } else if (const char* env = std::getenv("PHACO_SYNC_TO"); env && *env) {
+    o.sync_to = env;
+  }
+  if (!o.sync_to.empty() && !is_postgres_uri(o.sync_to))
+    throw InputError("--sync-to: expected a postgresql:// URI, got '" + shown_location(o.sync_to) +
+                     "'");
+  if (!o.sync_to.empty() && is_postgres_uri(o.db.string()))
+    throw InputError("--sync-to: the station records to its own file first; --db is a server");
   if (auto v = a.option("--size")) {
     const auto x = v->find('x');
     if (x == std::string::npos)

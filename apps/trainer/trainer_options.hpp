@@ -15,6 +15,9 @@ struct TrainerOptions {
   std::string left = "desktop", right = "desktop";  // device per hand (TrainerSession specs)
   std::string trainee;                              // records the finished drill when set
   std::filesystem::path db;                         // records database ("" = the default)
+  // A training centre's server (postgresql:// URI; --sync-to or $PHACO_SYNC_TO): the station's
+  // records are uploaded to it in the background after each stored drill ("" = no sync).
+  std::string sync_to;
   int width = 1280, height = 720;
   bool stereo = false, guidance = true, ui = true, render = true;
   int threads = 1;

@@ -8,6 +8,8 @@
 #include <fstream>
 
 #include "engine/core/error.hpp"
+#include "engine/records/background_sync.hpp"
+#include "engine/records/record_location.hpp"
 #include "engine/records/record_run.hpp"
 #include "engine/records/records.hpp"
 #include "procedures/report/html_report.hpp"
@@ -80,6 +82,7 @@ void TrainerUi::finish(TrainerSession& session) {
     else
       message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
                                                : std::string("finished (not stored: no trainee)");
+    if (sync_ && report_.contains("record_id")) sync_->request();
   } catch (const InputError& e) {
     message_ = e.what();
   }
@@ -241,7 +244,7 @@ void TrainerUi::history_panel() {
     history_ = nlohmann::json::array();
     try {
       const std::filesystem::path db = options_.db.empty() ? default_records_db() : options_.db;
-      if (std::filesystem::exists(db)) {
+      if (is_postgres_uri(db.string()) || std::filesystem::exists(db)) {
         RecordStore store(db, OpenMode::ExistingOnly);
         for (const SessionRecord& r : store.records_of(trainee_)) {
           history_.push_back({{"date", r.finished_utc.substr(0, 16)},
@@ -255,6 +258,7 @@ void TrainerUi::history_panel() {
   }
   ImGui::SameLine();
   ImGui::TextDisabled("%s", trainee_[0] ? trainee_ : "(no trainee)");
+  if (sync_) ImGui::TextWrapped("%s", sync_->status().c_str());
   for (const auto& h : history_) {
     ImGui::Text("%s  %-16s  %5.1f", h["date"].get<std::string>().c_str(),
                 h["drill"].get<std::string>().c_str(), h["score"].get<double>());

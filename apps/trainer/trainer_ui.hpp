@@ -13,6 +13,10 @@
 #include "engine/render/renderer.hpp"
 #include "procedures/trainer/trainer_session.hpp"
 
+namespace phaco {
+class BackgroundSync;
+}
+
 namespace phaco::trainer {
 
 enum class UiAction { None, Restart };  // Restart: build a new session from config()
@@ -27,6 +31,8 @@ class TrainerUi {
                 double frame_ms);
   // The configuration the user chose (after Restart).
   const TrainerConfig& config() const { return config_; }
+  // The background upload to a centre (--sync-to), asked after each stored drill; may be null.
+  void set_sync(BackgroundSync* sync) { sync_ = sync; }
 
  private:
   void finish(TrainerSession& session);  // the drill's report (and record), once
@@ -56,6 +62,7 @@ class TrainerUi {
   nlohmann::json report_;  // the last finished drill's
   bool finished_ = false;
   nlohmann::json history_ = nlohmann::json::array();
+  BackgroundSync* sync_ = nullptr;
 };
 
 }  // namespace phaco::trainer

@@ -1,6 +1,7 @@
 #pragma once
 // Calendar time, UTC, in the one format the records and run reports store:
 // "2026-11-21T19:30:00.123Z" (ISO 8601 with milliseconds; sorts as text in time order).
+#include <optional>
 #include <string>
 
 namespace phaco {
@@ -9,5 +10,8 @@ namespace phaco {
 std::string format_utc(double unix_seconds);
 // Now.
 std::string utc_now();
+// The inverse of format_utc: seconds since the Unix epoch, or nullopt when `text` is not in the
+// format (exactly "YYYY-MM-DDTHH:MM:SS.mmmZ", fields in range).
+std::optional<double> parse_utc(const std::string& text);
 
 }  // namespace phaco

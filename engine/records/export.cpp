@@ -130,7 +130,10 @@ std::string records_to_xml(const std::vector<SessionRecord>& records) {
   std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   out += "<openphaco_records schema=\"" + std::to_string(kRecordsSchemaVersion) + "\">\n";
   for (const SessionRecord& r : records) {
-    out += "  <session id=\"" + std::to_string(r.id) + "\">\n";
+    out += "  <session id=\"" + std::to_string(r.id) + "\"";
+    // The uuid (schema 2): the record's identity across stations and the centre.
+    if (!r.uuid.empty()) out += " uuid=\"" + r.uuid + "\"";
+    out += ">\n";
     element(out, "    ", "trainee", r.trainee);
     element(out, "    ", "drill", r.drill);
     element(out, "    ", "scenario", r.scenario_name);
@@ -163,6 +166,7 @@ json record_to_json(const SessionRecord& r) {
             {"metrics", r.metrics},
             {"score", r.score ? json(*r.score) : json(nullptr)},
             {"state_hash", r.state_hash},
+            {"uuid", r.uuid},
             {"recording", r.recording},
             {"report", r.report}};
   return j;

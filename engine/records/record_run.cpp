@@ -8,6 +8,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/core/utc_time.hpp"
+#include "engine/records/record_location.hpp"
 #include "engine/records/records.hpp"
 
 namespace phaco {
@@ -27,7 +28,7 @@ void check_trainee(const std::string& trainee) {
 }
 
 void make_parent_dir(const fs::path& db) {
-  if (!db.has_parent_path()) return;
+  if (is_postgres_uri(db.string()) || !db.has_parent_path()) return;
   std::error_code ec;
   fs::create_directories(db.parent_path(), ec);
   if (ec) throw InputError("cannot create '" + db.parent_path().string() + "': " + ec.message());
@@ -47,12 +48,13 @@ double run_seconds(const json& report, std::optional<double> run_s) {
 }  // namespace
 
 fs::path default_records_db() {
-  if (const char* env = std::getenv("PHACO_RECORDS_DB"); env && *env) return env;
+  for (const char* name : {"PHACO_DB", "PHACO_RECORDS_DB"})
+    if (const char* env = std::getenv(name); env && *env) return env;
   if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg)
     return fs::path(xdg) / "openphaco" / "records.sqlite";
   if (const char* home = std::getenv("HOME"); home && *home)
     return fs::path(home) / ".local" / "share" / "openphaco" / "records.sqlite";
-  throw InputError("no records database: give --db FILE or set PHACO_RECORDS_DB");
+  throw InputError("no records database: give --db FILE|URI or set PHACO_DB");
 }
 
 void check_record_target(const fs::path& db, const std::string& trainee) {

@@ -16,8 +16,9 @@
 
 namespace phaco {
 
-// $PHACO_RECORDS_DB, else $XDG_DATA_HOME/openphaco/records.sqlite, else
-// ~/.local/share/openphaco/records.sqlite. Throws InputError when none can be formed.
+// $PHACO_DB (a file or a postgresql:// URI), else $PHACO_RECORDS_DB (the older name), else
+// $XDG_DATA_HOME/openphaco/records.sqlite, else ~/.local/share/openphaco/records.sqlite. Throws
+// InputError when none can be formed.
 std::filesystem::path default_records_db();
 
 // Checks, before a drill starts, that its record can be written: the trainee name is acceptable

@@ -9,6 +9,7 @@
 #include "engine/core/error.hpp"
 #include "engine/core/utc_time.hpp"
 #include "engine/haptics/device_factory.hpp"
+#include "engine/records/record_location.hpp"
 #include "engine/records/record_run.hpp"
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/run.hpp"
@@ -317,9 +318,11 @@ std::vector<std::filesystem::path> TrainerSession::write_unsaved(
     const std::filesystem::path file =
         dir / (std::string(to_string(u.recording.drill)) + "-" + stamp + ".json");
     nlohmann::json j = to_json(u.recording);
-    j["description"] = "Unsaved trainer drill of '" + u.trainee + "' (the records database " +
-                       u.db.string() + " refused it); store it with: phaco run FILE --record " +
-                       u.db.string() + " --trainee NAME";
+    // The database as shown: a server URI's password must not land in a file.
+    const std::string db = shown_location(u.db.string());
+    j["description"] = "Unsaved trainer drill of '" + u.trainee + "' (the records database " + db +
+                       " refused it); store it with: phaco run FILE --record " + db +
+                       " --trainee NAME";
     std::ofstream out(file, std::ios::binary);
     out << j.dump(2) << "\n";
     if (!out) throw InputError(file.string() + ": cannot write the unsaved drill");

@@ -12,11 +12,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <set>
 #include <string>
 #include <thread>
 
 #include "engine/core/error.hpp"
+#include "engine/records/migrations.hpp"
+#include "engine/records/record_location.hpp"
 #include "engine/records/records.hpp"
+#include "tests/engine/records/sample_record.hpp"
 #include "tests/support/expect_invalid.hpp"
 
 namespace {
@@ -47,19 +51,7 @@ struct TempDb {
 };
 
 SessionRecord sample(const std::string& trainee, const std::string& started, double score) {
-  SessionRecord r;
-  r.trainee = trainee;
-  r.drill = "capsulorhexis";
-  r.scenario_name = "capsulorhexis demo";
-  r.started_utc = started;
-  r.finished_utc = started;  // same second: allowed
-  r.settings = {{"dt_s", 1.0 / 120.0}, {"seed", 7}, {"eye", {{"level", 2}}}};
-  r.metrics = {{"rhexis.diameter_mm", 5.25}, {"rhexis.complete", true}, {"score", score}};
-  r.score = score;
-  r.state_hash = "0123456789abcdef";
-  r.recording = {{"drill", "capsulorhexis"}, {"dt_s", 1.0 / 120.0}, {"hands", json::object()}};
-  r.report = {{"state_hash", "0123456789abcdef"}, {"frames", 10}};
-  return r;
+  return phaco::test::sample_record(trainee, started, score);
 }
 
 // Raw SQL on the file, as another program (or a damaged disk) would touch it.
@@ -162,6 +154,64 @@ TEST(Records, NewerSchemaVersionIsRefused) {
   const std::string msg = input_error_of([&] { RecordStore store(file); });
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
   EXPECT_NE(msg.find("schema version 7 is newer"), std::string::npos) << msg;
+}
+
+// Issue 21: a file an older phaco wrote (schema version 1, no uuids) is upgraded when opened:
+// its records read as before and each gets a uuid, distinct, in the RFC 4122 version-4 form.
+TEST(Records, AVersionOneFileIsUpgradedAndItsRecordsGetUuids) {
+  const TempDb tmp("upgrade");
+  const fs::path& file = tmp.file;
+  raw_sql(file, std::string(phaco::records::migrations()[0].sqlite) +
+                    "PRAGMA user_version = 1; INSERT INTO trainees(name, created) VALUES('ana', "
+                    "'x'); INSERT INTO records(trainee_id, drill, scenario_name, started_utc, "
+                    "finished_utc, settings, metrics, score, state_hash, recording, report) "
+                    "SELECT id, 'capsulorhexis', 's', '2026-01-0' || n || 'T00:00:00.000Z', "
+                    "'2026-01-0' || n || 'T00:00:01.000Z', '{}', '{\"score\": 7}', 7, 'h', '{}', "
+                    "'{}' FROM trainees, (SELECT 1 AS n UNION SELECT 2 UNION SELECT 3)");
+  RecordStore store(file, OpenMode::ExistingOnly);
+  EXPECT_EQ(store.schema_version(), 2);
+  const auto old = store.records_of("ana");
+  ASSERT_EQ(old.size(), 3u);
+  std::set<std::string> uuids;
+  for (const auto& r : old) {
+    EXPECT_EQ(*r.score, 7);
+    ASSERT_EQ(r.uuid.size(), 36u);
+    EXPECT_EQ(r.uuid[14], '4') << r.uuid;                                          // version 4
+    EXPECT_NE(std::string("89ab").find(r.uuid[19]), std::string::npos) << r.uuid;  // variant
+    uuids.insert(r.uuid);
+  }
+  EXPECT_EQ(uuids.size(), 3u);
+  EXPECT_EQ(store.integrity_check(), "ok");
+  // New records get a uuid of the same form, and a uuid is stored once.
+  SessionRecord r = sample("ana", "2026-02-01T00:00:00.000Z", 9);
+  r.uuid = phaco::new_record_uuid();
+  EXPECT_EQ(r.uuid[14], '4');
+  store.add_record(r);
+  EXPECT_NE(input_error_of([&] { store.add_record(r); }).find("already stored"), std::string::npos);
+  EXPECT_EQ(store.add_missing(std::vector<SessionRecord>{r}), 0u);
+  EXPECT_EQ(store.count(), 4);
+}
+
+// Issue 21: where records live, as it may be printed: a server URI's password never shows.
+TEST(Records, ALocationIsShownWithoutItsPassword) {
+  using phaco::is_postgres_uri;
+  using phaco::shown_location;
+  EXPECT_TRUE(is_postgres_uri("postgresql://u@h/d"));
+  EXPECT_TRUE(is_postgres_uri("postgres://u@h/d"));
+  EXPECT_FALSE(is_postgres_uri("/home/ana/records.sqlite"));
+  EXPECT_FALSE(is_postgres_uri("postgresql:/x"));
+  EXPECT_EQ(shown_location("postgresql://ana:s3cr:et@db.example:5432/centre"),
+            "postgresql://ana:***@db.example:5432/centre");
+  EXPECT_EQ(shown_location("postgresql://ana@db.example/centre"),
+            "postgresql://ana@db.example/centre");
+  EXPECT_EQ(shown_location("postgresql://ana:p%40ss@/centre?host=/run/pg&password=x&port=5"),
+            "postgresql://ana:***@/centre?host=/run/pg&password=***&port=5");
+  EXPECT_EQ(shown_location("postgres://h/d?sslmode=require&password=top"),
+            "postgres://h/d?sslmode=require&password=***");
+  EXPECT_EQ(shown_location("postgresql://u:a/b@h/d"), "postgresql://u:***@h/d");
+  EXPECT_EQ(shown_location("/tmp/a:b@c/records.sqlite"), "/tmp/a:b@c/records.sqlite");
+  EXPECT_NE(input_error_of([] { RecordStore store(""); }).find("no records database given"),
+            std::string::npos);
 }
 
 TEST(Records, ForeignSqliteDatabaseIsRefused) {
@@ -472,14 +522,16 @@ TEST(Records, MetricUnitsComeFromTheNames) {
 TEST(Records, XmlExportEscapesAndListsEveryMetricWithUnit) {
   SessionRecord r = sample("O'Brien <&> \"Jo\"", "2026-11-21T09:00:00.000Z", 77.25);
   r.id = 12;
+  r.uuid = "0f8e7a52-7d0c-4c55-9f4e-2b1d6c3a9e10";
   r.trainee += std::string("\x01\xff", 2);  // a control character and a byte that is not UTF-8
   r.metrics["left.contact_force_mN.max"] = 12.5;
   r.metrics["left.contact_force_mN.histogram"] = json::array({1, 2, 3});
   const std::string xml = phaco::records_to_xml({r});
   EXPECT_EQ(
-      xml.rfind("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<openphaco_records schema=\"1\">", 0),
+      xml.rfind("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<openphaco_records schema=\"2\">", 0),
       0u);
-  EXPECT_NE(xml.find("<session id=\"12\">"), std::string::npos);
+  EXPECT_NE(xml.find("<session id=\"12\" uuid=\"0f8e7a52-7d0c-4c55-9f4e-2b1d6c3a9e10\">"),
+            std::string::npos);
   EXPECT_NE(
       xml.find(
           "<trainee>O&apos;Brien &lt;&amp;&gt; &quot;Jo&quot;\xEF\xBF\xBD\xEF\xBF\xBD</trainee>"),
