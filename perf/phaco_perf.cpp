@@ -13,6 +13,7 @@
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
 //   phaco-perf sweep        issue 9: every drill at every level, thread count and method
 //   phaco-perf soak         issue 18: the trainer drill after drill; memory, GL objects, haptics
+//   phaco-perf records      issue 21: 1, 4, 16 stations syncing to one PostgreSQL server at once
 //   alternative,
 //                           with the haptic thread beside it; the targets; the checks CI runs
 //   phaco-perf all          every study above, in that order
@@ -113,6 +114,11 @@ studies:
       --reference-dt-divisor change every chosen drill's recipe. About 5 minutes on an idle
       machine (11 under load). docs/perf_sweep.md says why the whole capsule
       (capsule.active_set=off) is not in it.
+  records [--pg ADMIN_URI]
+      Issue 21, 1, 4 and 16 stations (processes, 200 records each) syncing to one PostgreSQL
+      server at once: records per second, batch latency p50/p99/max, every record at the centre
+      once. The server is a throwaway cluster (scripts/pg_test_cluster.sh) unless --pg names an
+      administrator's URI ending in /postgres?... (a database is made and dropped on it).
   soak [--seconds S]
       Issue 18, phaco-trainer left running drill after drill under Xvfb (phaco-trainer --soak):
       the three drills in turn, scripted hands, 6 simulated s each, for S wall seconds (default
@@ -178,6 +184,8 @@ int main(int argc, char** argv) {
       perf::run_sweep(options);
     } else if (cmd == "soak") {
       perf::run_soak(options);
+    } else if (cmd == "records") {
+      perf::run_records(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");

@@ -76,7 +76,7 @@ const std::vector<std::string>& study_order() {
   // The sweep first: it holds the issue-9 targets and the reading of the whole trainer.
   static const std::vector<std::string> order = {
       "sweep",   "foundation", "bandwidth",  "membrane", "cut", "lens",
-      "haptics", "drills",     "tear_force", "trainer",  "soak"};
+      "haptics", "drills",     "tear_force", "trainer",  "soak", "records"};
   return order;
 }
 
