@@ -1,9 +1,9 @@
-// One file for now: codec, CRC, seqlock, sockets and the I/O thread of one device; issue 22 splits
-// the codec from the transport.
+// The bridge device: its I/O thread and the haptic thread's side (issue 6 item 4). The codec is
+// udp_protocol.cpp, the seqlock seqlock.hpp, the socket helpers udp_socket.cpp, the peer
+// udp_bridge_peer.cpp.
 #include "engine/haptics/udp_bridge.hpp"
 
 #include <arpa/inet.h>
-#include <netdb.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -16,212 +16,21 @@
 #include <cstring>
 #include <limits>
 #include <thread>
-#include <type_traits>
 
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
 #include "engine/haptics/sample_bounds.hpp"
+#include "engine/haptics/seqlock.hpp"
+#include "engine/haptics/udp_socket.hpp"
 
 namespace phaco {
-
-// ---------------------------------------------------------------------------------------------
-// Protocol
-// ---------------------------------------------------------------------------------------------
-namespace udp_protocol {
-
-namespace {
-
-// Byte offsets (docs/udp_bridge_protocol.md). Common header, then the payload, then the CRC.
-constexpr std::size_t kOffMagic = 0, kOffVersion = 4, kOffType = 6, kOffDeviceId = 8, kOffSeq = 12,
-                      kOffTime = 16, kOffPayload = 24, kOffCrc = 64;
-
-constexpr std::array<uint32_t, 256> make_crc_table() {
-  std::array<uint32_t, 256> t{};
-  for (uint32_t i = 0; i < 256; ++i) {
-    uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    t[i] = c;
-  }
-  return t;
-}
-constexpr std::array<uint32_t, 256> kCrcTable = make_crc_table();
-
-// Little-endian field access, byte by byte so that it is right on any host.
-template <typename U>
-void put(uint8_t* p, U v) {
-  static_assert(std::is_unsigned_v<U>);
-  for (std::size_t i = 0; i < sizeof(U); ++i) p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
-template <typename U>
-U get(const uint8_t* p) {
-  U v = 0;
-  for (std::size_t i = 0; i < sizeof(U); ++i) v |= static_cast<U>(static_cast<U>(p[i]) << (8 * i));
-  return v;
-}
-void put_f32(uint8_t* p, float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, 4);
-  put(p, u);
-}
-float get_f32(const uint8_t* p) {
-  const uint32_t u = get<uint32_t>(p);
-  float f;
-  std::memcpy(&f, &u, 4);
-  return f;
-}
-
-void put_header(Packet& b, MessageType type, uint32_t device_id, uint32_t seq, uint64_t time_us) {
-  put(&b[kOffMagic], kMagic);
-  put(&b[kOffVersion], kVersion);
-  b[kOffType] = static_cast<uint8_t>(type);
-  b[kOffType + 1] = 0;  // flags, reserved
-  put(&b[kOffDeviceId], device_id);
-  put(&b[kOffSeq], seq);
-  put(&b[kOffTime], time_us);
-}
-
-void seal(Packet& b) {
-  put(&b[kOffCrc], crc32(std::span<const uint8_t>(b.data(), kOffCrc)));
-}
-
-DecodeStatus check(std::span<const uint8_t> bytes, MessageType type) {
-  // Version before size, so that a future version with another size is reported as a version
-  // mismatch rather than as garbage.
-  if (bytes.size() < kOffVersion + 2) return DecodeStatus::Malformed;
-  if (get<uint32_t>(&bytes[kOffMagic]) != kMagic) return DecodeStatus::Malformed;
-  if (get<uint16_t>(&bytes[kOffVersion]) != kVersion) return DecodeStatus::WrongVersion;
-  if (bytes.size() != kPacketSize) return DecodeStatus::Malformed;
-  if (get<uint32_t>(&bytes[kOffCrc]) != crc32(bytes.first(kOffCrc))) {
-    return DecodeStatus::BadChecksum;
-  }
-  if (bytes[kOffType] != static_cast<uint8_t>(type)) return DecodeStatus::WrongType;
-  return DecodeStatus::Ok;
-}
-
-}  // namespace
-
-uint32_t crc32(std::span<const uint8_t> bytes) {
-  uint32_t c = 0xFFFFFFFFu;
-  for (const uint8_t x : bytes) c = kCrcTable[(c ^ x) & 0xFFu] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
-}
-
-Packet encode(const PoseMessage& m) {
-  Packet b{};
-  put_header(b, MessageType::Pose, m.device_id, m.seq, m.sender_time_us);
-  uint8_t* p = &b[kOffPayload];
-  for (int i = 0; i < 3; ++i) put_f32(p + 4 * i, m.pos_mm[i]);     // 24..35
-  for (int i = 0; i < 4; ++i) put_f32(p + 12 + 4 * i, m.quat[i]);  // 36..51
-  put_f32(p + 28, m.grip);                                         // 52
-  put_f32(p + 32, m.pedal);                                        // 56
-  put(p + 36, m.buttons);                                          // 60
-  seal(b);
-  return b;
-}
-
-Packet encode(const ForceMessage& m) {
-  Packet b{};
-  put_header(b, MessageType::Force, m.device_id, m.seq, m.sender_time_us);
-  uint8_t* p = &b[kOffPayload];
-  for (int i = 0; i < 3; ++i) put_f32(p + 4 * i, m.force_mn[i]);  // 24..35
-  put(p + 12, m.ack_seq);                                         // 36
-  put(p + 16, m.ack_sender_time_us);                              // 40
-  p[24] = m.health;                                               // 48; 49..63 reserved, zero
-  seal(b);
-  return b;
-}
-
-DecodeStatus decode(std::span<const uint8_t> bytes, PoseMessage& out) {
-  const DecodeStatus s = check(bytes, MessageType::Pose);
-  if (s != DecodeStatus::Ok) return s;
-  const uint8_t* p = &bytes[kOffPayload];
-  out.device_id = get<uint32_t>(&bytes[kOffDeviceId]);
-  out.seq = get<uint32_t>(&bytes[kOffSeq]);
-  out.sender_time_us = get<uint64_t>(&bytes[kOffTime]);
-  for (int i = 0; i < 3; ++i) out.pos_mm[i] = get_f32(p + 4 * i);
-  for (int i = 0; i < 4; ++i) out.quat[i] = get_f32(p + 12 + 4 * i);
-  out.grip = get_f32(p + 28);
-  out.pedal = get_f32(p + 32);
-  out.buttons = get<uint32_t>(p + 36);
-  return DecodeStatus::Ok;
-}
-
-DecodeStatus decode(std::span<const uint8_t> bytes, ForceMessage& out) {
-  const DecodeStatus s = check(bytes, MessageType::Force);
-  if (s != DecodeStatus::Ok) return s;
-  const uint8_t* p = &bytes[kOffPayload];
-  out.device_id = get<uint32_t>(&bytes[kOffDeviceId]);
-  out.seq = get<uint32_t>(&bytes[kOffSeq]);
-  out.sender_time_us = get<uint64_t>(&bytes[kOffTime]);
-  for (int i = 0; i < 3; ++i) out.force_mn[i] = get_f32(p + 4 * i);
-  out.ack_seq = get<uint32_t>(p + 12);
-  out.ack_sender_time_us = get<uint64_t>(p + 16);
-  out.health = p[24];
-  return DecodeStatus::Ok;
-}
-
-}  // namespace udp_protocol
-
-uint64_t steady_time_us() {
-  return static_cast<uint64_t>(now_ns() / 1000);
-}
 
 namespace {
 
 using namespace udp_protocol;
-
-// Single writer, single reader, the value copied through atomic words so that a torn read is a
-// detected retry rather than a data race (and ThreadSanitizer agrees). The reader never waits: it
-// tries a few times and otherwise keeps what it had; the writer holds the odd count for ~20 ns.
-template <typename T>
-class Seqlock {
-  static_assert(std::is_trivially_copyable_v<T>);
-  static constexpr std::size_t kWords = (sizeof(T) + 7) / 8;
-
- public:
-  void store(const T& v) noexcept {
-    uint64_t w[kWords] = {};
-    std::memcpy(w, &v, sizeof(T));
-    // Relaxed: this thread is the only writer of seq_.
-    const uint32_t s = seq_.load(std::memory_order_relaxed);
-    seq_.store(s + 1, std::memory_order_relaxed);
-    // Release fence: the odd count is visible before any new word is.
-    std::atomic_thread_fence(std::memory_order_release);
-    // Relaxed: ordered by the fence above and the release store below.
-    for (std::size_t i = 0; i < kWords; ++i) words_[i].store(w[i], std::memory_order_relaxed);
-    // Release: the words are visible before the even count that vouches for them.
-    seq_.store(s + 2, std::memory_order_release);
-  }
-
-  bool load(T& out) const noexcept {
-    for (int attempt = 0; attempt < 4; ++attempt) {
-      // Acquire: pairs with the writer's final release store; the words read below are at least
-      // as new as this count.
-      const uint32_t s0 = seq_.load(std::memory_order_acquire);
-      if (s0 == 0) return false;  // never written
-      if (s0 & 1u) continue;      // a write in progress
-      uint64_t w[kWords];
-      // Relaxed: validated by the count re-check below.
-      for (std::size_t i = 0; i < kWords; ++i) w[i] = words_[i].load(std::memory_order_relaxed);
-      // Acquire fence: the word loads complete before the re-check (pairs with the writer's
-      // release fence).
-      std::atomic_thread_fence(std::memory_order_acquire);
-      // Relaxed: ordered by the fence above.
-      if (seq_.load(std::memory_order_relaxed) == s0) {
-        std::memcpy(&out, w, sizeof(T));
-        return true;
-      }
-    }
-    return false;
-  }
-
-  // Changes on every store. Acquire: a reader that sees a new version then loads the new value.
-  uint32_t version() const noexcept { return seq_.load(std::memory_order_acquire); }
-
- private:
-  std::atomic<uint32_t> seq_{0};
-  std::array<std::atomic<uint64_t>, kWords> words_{};
-};
+using udp_socket::bind_udp;
+using udp_socket::resolve_ipv4;
+using udp_socket::same_endpoint;
 
 // Plain data for the seqlocks (Eigen types are not trivially copyable).
 struct PosePayload {
@@ -238,53 +47,6 @@ struct ForcePayload {
   uint32_t ack_seq;
   uint32_t health;
 };
-
-sockaddr_in resolve_ipv4(const std::string& host, uint16_t port, const std::string& what) {
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(port);
-  if (inet_pton(AF_INET, host.c_str(), &a.sin_addr) == 1) return a;
-  addrinfo hints{};
-  hints.ai_family = AF_INET;
-  hints.ai_socktype = SOCK_DGRAM;
-  addrinfo* res = nullptr;
-  const int rc = getaddrinfo(host.c_str(), nullptr, &hints, &res);
-  if (rc != 0 || res == nullptr) {
-    throw InputError(what + ": cannot resolve host '" + host +
-                     "' to an IPv4 address: " + (rc != 0 ? gai_strerror(rc) : "no address"));
-  }
-  a.sin_addr = reinterpret_cast<const sockaddr_in*>(res->ai_addr)->sin_addr;
-  freeaddrinfo(res);
-  return a;
-}
-
-// A UDP socket bound to host:port; returns the fd and the port actually bound.
-int bind_udp(const std::string& host, uint16_t port, const std::string& what,
-             uint16_t& bound_port) {
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(port);
-  if (inet_pton(AF_INET, host.c_str(), &a.sin_addr) != 1) {
-    throw InputError(what + ": bind address '" + host +
-                     "' is not a numeric IPv4 address (e.g. 0.0.0.0 or 127.0.0.1)");
-  }
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw InputError(what + ": cannot create a UDP socket: " + std::strerror(errno));
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0) {
-    const int e = errno;
-    ::close(fd);
-    throw InputError(what + ": cannot bind UDP " + host + ":" + std::to_string(port) + ": " +
-                     std::strerror(e));
-  }
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  bound_port = ntohs(a.sin_port);
-  return fd;
-}
-
-bool same_endpoint(const sockaddr_in& a, const sockaddr_in& b) {
-  return a.sin_addr.s_addr == b.sin_addr.s_addr && a.sin_port == b.sin_port;
-}
 
 }  // namespace
 
@@ -584,55 +346,6 @@ DeviceCounters UdpBridgeDevice::counters() const {
   c.clamped = r(d.clamped);
   c.silences = r(d.silences);
   return c;
-}
-
-// ---------------------------------------------------------------------------------------------
-// The peer
-// ---------------------------------------------------------------------------------------------
-UdpBridgePeer::UdpBridgePeer(uint16_t local_port, const std::string& bind_host) {
-  fd_ = bind_udp(bind_host, local_port, "udp peer", local_port_);
-}
-
-UdpBridgePeer::~UdpBridgePeer() {
-  if (fd_ >= 0) ::close(fd_);
-}
-
-void UdpBridgePeer::set_device(const std::string& host, uint16_t port) {
-  const sockaddr_in a = resolve_ipv4(host, port, "udp peer: device");
-  static_assert(sizeof a == sizeof device_addr_);
-  std::memcpy(device_addr_.data(), &a, sizeof a);
-  has_device_ = true;
-}
-
-void UdpBridgePeer::send_raw(std::span<const uint8_t> bytes) {
-  if (!has_device_) throw InputError("udp peer: set_device() before sending");
-  const ssize_t n =
-      ::sendto(fd_, bytes.data(), bytes.size(), 0,
-               reinterpret_cast<const sockaddr*>(device_addr_.data()), sizeof(sockaddr_in));
-  if (n < 0) throw InputError(std::string("udp peer: send failed: ") + std::strerror(errno));
-}
-
-void UdpBridgePeer::send(const PoseMessage& m) {
-  const Packet b = encode(m);
-  send_raw(b);
-}
-
-std::optional<ForceMessage> UdpBridgePeer::receive_force(double timeout_ms) {
-  const int64_t deadline = now_ns() + std::llround(timeout_ms * 1e6);
-  std::array<uint8_t, 2048> buf{};
-  for (;;) {
-    const int64_t left_ms = (deadline - now_ns() + 999'999) / 1'000'000;
-    if (left_ms <= 0) return std::nullopt;
-    pollfd pfd{fd_, POLLIN, 0};
-    if (::poll(&pfd, 1, static_cast<int>(left_ms)) <= 0) continue;
-    const ssize_t n = ::recv(fd_, buf.data(), buf.size(), MSG_DONTWAIT);
-    if (n <= 0) continue;
-    ForceMessage m;
-    if (decode(std::span<const uint8_t>(buf.data(), static_cast<std::size_t>(n)), m) ==
-        DecodeStatus::Ok) {
-      return m;
-    }
-  }
 }
 
 }  // namespace phaco
