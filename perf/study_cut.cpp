@@ -12,7 +12,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/io/scenario.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
 #include "procedures/eye/eye_mesh.hpp"

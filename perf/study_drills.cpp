@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
 #include "procedures/compare/compare.hpp"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/haptics/loop_measure.hpp"
 #include "perf/haptics/scene_haptics_measure.hpp"
 #include "perf/haptics/stability_measure.hpp"

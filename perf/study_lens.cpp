@@ -13,7 +13,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/io/scenario.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/lens/fragment_lens_measure.hpp"
 #include "perf/lens/lens_tools_measure.hpp"
 #include "perf/lens/sculpt_measure.hpp"

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/membrane_fixture.hpp"
 #include "perf/membrane_methods.hpp"
 #include "perf/report.hpp"

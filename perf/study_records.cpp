@@ -22,7 +22,7 @@
 #include "engine/core/error.hpp"
 #include "engine/records/records.hpp"
 #include "engine/records/sync.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
 

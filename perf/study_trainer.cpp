@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
 

@@ -1,9 +1,9 @@
-// The sweep's charts (issue 9 item 3), drawn with perf/chart.hpp on OpenCV.
+// The sweep's charts (issue 9 item 3), drawn with engine/plot/chart.hpp on OpenCV.
 #include <algorithm>
 #include <cmath>
 #include <set>
 
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/sweep/sweep_data.hpp"
 
 namespace phaco::perf {

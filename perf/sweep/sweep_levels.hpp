@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "perf/chart.hpp"
+#include "perf/plot.hpp"
 #include "perf/sweep/sweep_data.hpp"
 
 namespace phaco::perf {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "engine/core/markup.hpp"
-#include "perf/chart.hpp"
+#include "engine/plot/chart.hpp"
 #include "procedures/report/html_report.hpp"
 
 namespace phaco::report {
@@ -28,19 +28,19 @@ std::string cell(const std::string& s) {
 std::string plot(const compare::Comparison& c) {
   auto panel = [&](const std::string& title, const std::string& y_label,
                    std::vector<double> compare::HandComparison::*field) {
-    perf::Chart chart;
+    plot::Chart chart;
     chart.title = title;
     chart.x.label = "run time (s)";
     chart.y.label = y_label;
     chart.width = 1000, chart.height = 360;
     for (const compare::HandComparison& h : c.hands) {
-      perf::Series s;
+      plot::Series s;
       s.name = h.hand;
-      s.style = perf::Style::Line;
+      s.style = plot::Style::Line;
       s.x = h.t_s, s.y = h.*field;
       chart.series.push_back(std::move(s));
     }
-    return perf::render_chart(chart);
+    return plot::render_chart(chart);
   };
   cv::Mat img;
   cv::vconcat(panel("Path distance to the expert after DTW alignment", "distance (mm)",

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "perf/chart.hpp"
+#include "engine/plot/chart.hpp"
 #include "procedures/report/report_fields.hpp"
 
 namespace phaco::report {
@@ -26,9 +26,9 @@ namespace phaco::report {
 namespace {
 
 using nlohmann::json;
-using perf::Chart;
-using perf::Series;
-using perf::Style;
+using plot::Chart;
+using plot::Series;
+using plot::Style;
 using namespace fields;  // the report's fields, read and checked (report_fields.hpp)
 
 // ---------------------------------------------------------------------------------------------
@@ -77,7 +77,7 @@ std::string png_data_uri(const cv::Mat& img) {
 }
 
 std::string figure(const std::string& id, const std::string& caption, const Chart& chart) {
-  const cv::Mat img = perf::render_chart(chart);
+  const cv::Mat img = plot::render_chart(chart);
   return "<figure id=\"plot-" + id + "\"><img alt=\"" + escape(chart.title) + "\" width=\"" +
          std::to_string(img.cols) + "\" height=\"" + std::to_string(img.rows) + "\" src=\"" +
          png_data_uri(img) + "\"><figcaption>" + escape(caption) + "</figcaption></figure>\n";
@@ -303,7 +303,7 @@ std::string rhexis_figure(const Run& r, std::string& notes) {
         "Rhexis: the report gives no target diameter (series.rhexis.target_diameter_mm); "
         "the outline is drawn alone.");
   }
-  perf::Marker m;
+  plot::Marker m;
   m.label = "target centre";
   m.x = centre[0], m.y = centre[1];
   c.markers.push_back(m);

@@ -1,4 +1,4 @@
-#include "perf/chart.hpp"
+#include "engine/plot/chart.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-namespace phaco::perf {
+namespace phaco::plot {
 
 namespace {
 
@@ -384,4 +384,4 @@ RenderReport save_chart(const Chart& chart, const std::filesystem::path& png) {
   return report;
 }
 
-}  // namespace phaco::perf
+}  // namespace phaco::plot

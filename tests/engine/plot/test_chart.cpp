@@ -1,4 +1,4 @@
-// perf/chart: renders real pixels, maps log axes by decades, fits power laws exactly, and survives
+// engine/plot/chart: renders real pixels, maps log axes by decades, fits power laws exactly, and survives
 // bad input (NaN, empty series, non-positive values on a log axis) by skipping and reporting.
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "perf/chart.hpp"
+#include "engine/plot/chart.hpp"
 
-namespace phaco::perf {
+namespace phaco::plot {
 namespace {
 
 // Pixels that are neither white nor grey-ish text: coloured series ink.
@@ -178,4 +178,4 @@ TEST(Chart, SavesPng) {
 }
 
 }  // namespace
-}  // namespace phaco::perf
+}  // namespace phaco::plot

@@ -1,5 +1,6 @@
 #pragma once
-// A small chart library on OpenCV for the perf harness: line and scatter series on linear or
+// A small chart library on OpenCV (issue 22: a library of the engine, used by the perf harness
+// and by the trainee's run report alike): line and scatter series on linear or
 // log10 axes (decade ticks), axis labels with units, title, legend, a fitted power-law slope drawn
 // and annotated ("slope 1.02"), reference markers (published figures), and the Pareto front of a
 // speed-versus-accuracy chart (lower-left is better on both axes).
@@ -18,7 +19,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace phaco::perf {
+namespace phaco::plot {
 
 enum class Scale { Linear, Log10 };
 
@@ -99,4 +100,4 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report = nullptr);
 // render_chart then cv::imwrite; throws std::runtime_error naming the file if it cannot be written.
 RenderReport save_chart(const Chart& chart, const std::filesystem::path& png);
 
-}  // namespace phaco::perf
+}  // namespace phaco::plot
