@@ -9,15 +9,16 @@ namespace phaco::deform {
 
 namespace {
 
+// One constraint projection of the Gauss-Seidel sweep. `d` is the step's scratch: its in_play
+// marks are read, its displacements written (one object, one name).
 struct Projector {
   const Membrane& m;
-  const XpbdScratch& scratch;
   XpbdScratch& d;
   bool restricted;
   float inv_dt2;
 
   float weight(uint32_t i) const {
-    if (restricted && scratch.in_play[i] == 0) return 0.0f;
+    if (restricted && d.in_play[i] == 0) return 0.0f;
     return integrating_inv_mass(m, i);
   }
 
@@ -89,7 +90,7 @@ Motion xpbd_step(Membrane& m, double dt_s, XpbdScratch& sc) {
     std::fill(sc.lambda.begin(), sc.lambda.end(), 0.0f);
   }
 
-  const Projector proj{m, sc, sc, restricted, 1.0f / (dt * dt)};
+  const Projector proj{m, sc, restricted, 1.0f / (dt * dt)};
   const Glue* glue =
       m.glue && m.dynamics.glue_stiffness_mn_mm > 0.0f && m.glue->x.size() == n ? m.glue : nullptr;
   const float glue_alpha = glue ? 1.0f / (m.dynamics.glue_stiffness_mn_mm * dt * dt) : 0.0f;
