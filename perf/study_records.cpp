@@ -126,7 +126,8 @@ Level run_level(const std::string& uri, const fs::path& dir, int stations, int e
         std::ofstream out(files[static_cast<size_t>(s)].string() + ".ms");
         for (double v : ms) out << v << "\n";
         if (r.uploaded != static_cast<size_t>(each)) code = 4;
-      } catch (...) {
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "records: station %d: %s\n", s, e.what());
         code = 5;
       }
       _exit(code);

@@ -6,6 +6,7 @@
 // refused, never read (docs/records.md, "Versions").
 //
 // Where a version lives: SQLite's PRAGMA user_version; PostgreSQL's one-row table phaco_schema.
+#include <cstdint>
 #include <span>
 
 namespace phaco::records {
@@ -18,6 +19,10 @@ struct Migration {
 };
 
 std::span<const Migration> migrations();
+
+// The advisory lock (pg_advisory_xact_lock) a PostgreSQL database's schema is created and
+// upgraded under, so that stations meeting it at once apply each migration once.
+inline constexpr int64_t kPostgresSchemaLock = 0x7068'6163'6f00;  // "phaco"
 
 // The newest version (the last migration's).
 int newest_schema_version();

@@ -30,10 +30,6 @@ constexpr const char* kRecordColumns =
     "r.id, t.name, r.drill, r.scenario_name, r.started_utc, r.finished_utc, r.settings, "
     "r.metrics, r.score, r.state_hash, r.recording, r.report, r.uuid";
 
-// One lock number for "this process is changing the schema" (pg_advisory_xact_lock): stations
-// opening a fresh centre database at once create it once.
-constexpr int64_t kSchemaLock = 0x7068'6163'6f00;  // "phaco"
-
 // SQLSTATEs after which the whole transaction may simply be run again.
 bool retryable(const std::string& sqlstate) {
   return sqlstate == "40P01" /* deadlock */ || sqlstate == "40001" /* serialization */;
@@ -247,42 +243,57 @@ class PostgresRecords final : public RecordBackend {
     return read_row(r, 0);
   }
 
-  int read_version() const {
-    const Result t = exec("SELECT to_regclass('phaco_schema') IS NOT NULL", {}, "cannot read");
-    if (t.text(0, 0) != "t") {
-      const Result other = exec(
-          "SELECT count(*) FROM information_schema.tables WHERE table_schema = current_schema() "
-          "AND table_name IN ('trainees', 'records')",
-          {}, "cannot read the schema");
-      if (other.integer(0, 0) > 0) {
-        throw InputError(shown_ +
-                         ": this database has tables named trainees or records but no OpenPhaco "
-                         "records schema version (phaco_schema); use a database of its own");
-      }
-      return 0;
-    }
+  // How many of `names` (SQL list) are tables of the current schema. A query over the catalog,
+  // not to_regclass(): that name lookup may answer from a cache not yet told of another
+  // session's commit (seen: after waiting for the schema lock, it missed phaco_schema).
+  int64_t tables_named(const char* names) const {
+    return exec(std::string("SELECT count(*) FROM information_schema.tables WHERE table_schema = "
+                            "current_schema() AND table_name IN (") +
+                    names + ")",
+                {}, "cannot read the schema")
+        .integer(0, 0);
+  }
+
+  // The version, or 0 when the database has no phaco_schema table yet.
+  int stored_version() const {
+    if (tables_named("'phaco_schema'") == 0) return 0;
     const Result v = exec("SELECT version FROM phaco_schema", {}, "cannot read the version");
     return v.rows() == 1 ? static_cast<int>(v.integer(0, 0)) : 0;
   }
 
-  // Each missing migration in one transaction with its version bump, under an advisory lock so
-  // that stations meeting a fresh or old centre database at the same moment apply it once.
-  void upgrade() {
-    version_ = read_version();
-    if (version_ > newest_schema_version()) {
-      throw InputError(shown_ + ": records schema version " + std::to_string(version_) +
+  void refuse_newer(int version) const {
+    if (version > newest_schema_version()) {
+      throw InputError(shown_ + ": records schema version " + std::to_string(version) +
                        " is newer than this phaco understands (" +
                        std::to_string(newest_schema_version()) + "); use a newer phaco");
     }
+  }
+
+  // Each missing migration in one transaction with its version bump, under an advisory lock so
+  // that stations meeting a fresh or old centre database at the same moment apply it once. What
+  // is there is judged only under the lock: outside it, another station's schema may appear
+  // between two reads (its tables, then its version), which would look like a foreign database.
+  void upgrade() {
+    version_ = stored_version();
+    refuse_newer(version_);
     if (version_ == newest_schema_version()) return;
     in_transaction("cannot upgrade the records schema", [&] {
-      exec("SELECT pg_advisory_xact_lock($1)", {std::to_string(kSchemaLock)},
+      exec("SELECT pg_advisory_xact_lock($1)", {std::to_string(kPostgresSchemaLock)},
            "cannot lock the schema");
-      exec("CREATE TABLE IF NOT EXISTS phaco_schema(version INTEGER NOT NULL)", {},
-           "cannot create the schema");
-      int now = read_version();
-      if (exec("SELECT count(*) FROM phaco_schema", {}, "cannot read").integer(0, 0) == 0)
-        exec("INSERT INTO phaco_schema(version) VALUES(0)", {}, "cannot create the schema");
+      int now = stored_version();
+      refuse_newer(now);
+      if (now == 0) {
+        if (tables_named("'trainees', 'records'") > 0 && tables_named("'phaco_schema'") == 0) {
+          throw InputError(shown_ +
+                           ": this database has tables named trainees or records but no "
+                           "OpenPhaco records schema version (phaco_schema); use a database of "
+                           "its own");
+        }
+        exec("CREATE TABLE IF NOT EXISTS phaco_schema(version INTEGER NOT NULL)", {},
+             "cannot create the schema");
+        if (exec("SELECT count(*) FROM phaco_schema", {}, "cannot read").integer(0, 0) == 0)
+          exec("INSERT INTO phaco_schema(version) VALUES(0)", {}, "cannot create the schema");
+      }
       for (const Migration& m : migrations()) {
         if (m.version <= now) continue;
         Result r(PQexec(conn_, m.postgres));  // several statements, no parameters
