@@ -51,9 +51,15 @@ class LensReflexMap {
 
   static constexpr int kFundusSegments = 48;
 
-  GLuint texture_ = 0;
-  int texture_size_ = 1;
-  GLuint fundus_vao_ = 0, fundus_buffers_[2] = {};
+  // Two of each, written in turn (lens_reflex.cpp says why).
+  struct Slot {
+    GLuint texture = 0;
+    int size = 1;  // texels per side
+    GLuint fundus_vao = 0, fundus_positions = 0;
+  };
+  Slot slots_[2];
+  int current_ = 0;  // the slot drawn with
+  GLuint fundus_normals_ = 0;
   bool has_lens_ = false;
   ThicknessMap map_;
   std::vector<std::array<float, 4>> texels_;
