@@ -1,7 +1,8 @@
 // One file for now: the passes share one GL state and its slots; issue 22 splits them by job.
 // The microscope view (renderer.hpp). Per view (one, or two for side-by-side stereo) the passes
 // are:
-//   1. opaque tissue: sclera, iris, lens surface (red reflex), exposed nucleus
+//   1. opaque tissue: sclera, iris, lens surface (red reflex dimmed by the lens's thickness map,
+//      lens_reflex.hpp), exposed nucleus, the fundus's glow behind the lens
 //   2. instruments (opaque steel)
 //   3. instrument shadows projected along the illuminator onto lens/iris, once per pixel (stencil)
 //   4. translucent membranes: capsule (pulled forward by a polygon offset: it lies on the lens),
@@ -315,15 +316,16 @@ struct Renderer::Impl {
       capacity = slot.vertex_capacity * sizeof(float);
       upload(GL_ARRAY_BUFFER, slot.normals, slot.normal.data(), bytes, capacity, stats);
       slot.vertex_capacity = capacity / sizeof(float);
-      // A fragmented lens's pieces (attribute 2; without them the attribute reads 0).
+      // A fragmented lens's pieces (attribute 2; without them, or with a count that is not the
+      // vertices', the attribute reads 0).
       glBindVertexArray(slot.vao);
-      if (!b.piece.empty())
+      if (b.piece.empty() || b.piece.size() != b.xyz.size() / 3) {
+        glDisableVertexAttribArray(2);
+      } else {
         upload(GL_ARRAY_BUFFER, slot.pieces, b.piece.data(), b.piece.size(), slot.piece_capacity,
                stats);
-      if (b.piece.empty())
-        glDisableVertexAttribArray(2);
-      else
         glEnableVertexAttribArray(2);
+      }
       glBindVertexArray(0);
       if (b.topology_version != slot.topology_version) {
         glBindVertexArray(slot.vao);  // the element buffer binding is VAO state
