@@ -1,7 +1,8 @@
 // One file for now: the passes share one GL state and its slots; issue 22 splits them by job.
 // The microscope view (renderer.hpp). Per view (one, or two for side-by-side stereo) the passes
 // are:
-//   1. opaque tissue: sclera, iris, lens surface (red reflex), exposed nucleus
+//   1. opaque tissue: sclera, iris, lens surface (red reflex dimmed by the lens's thickness map,
+//      lens_reflex.hpp), exposed nucleus, the fundus's glow behind the lens
 //   2. instruments (opaque steel)
 //   3. instrument shadows projected along the illuminator onto lens/iris, once per pixel (stencil)
 //   4. translucent membranes: capsule (pulled forward by a polygon offset: it lies on the lens),
@@ -16,8 +17,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
+#include "engine/render/lens_reflex.hpp"
 #include "engine/render/procedural.hpp"
 #include "engine/render/shaders.hpp"
 
@@ -133,7 +136,8 @@ void set_vec3(GLuint program, const char* name, const Vec3& v) {
 
 struct Renderer::Impl {
   struct BodySlot {
-    GLuint vao = 0, positions = 0, normals = 0, indices = 0;
+    GLuint vao = 0, positions = 0, normals = 0, indices = 0, pieces = 0;
+    size_t piece_capacity = 0;   // bytes the piece buffer holds
     size_t vertex_capacity = 0;  // floats the vertex buffers hold
     size_t index_capacity = 0;   // indices the index buffer holds
     uint32_t index_count = 0;
@@ -155,6 +159,7 @@ struct Renderer::Impl {
   int iris_baked_colour = -1;  // which polar image iris_texture holds, at which pupil ratio
   double iris_baked_ratio = -1;
   std::vector<BodySlot> bodies;
+  std::unique_ptr<LensReflexMap> lens_map;  // the lens looks' thickness map (lens_reflex.hpp)
   ToolSlot tool_bodies[6], tool_jaw;
   GLuint overlay_vao = 0, overlay_vbo = 0;
   size_t overlay_capacity = 0;  // vertices
@@ -279,11 +284,12 @@ struct Renderer::Impl {
     while (bodies.size() < s.bodies.size()) {
       BodySlot slot;
       glGenVertexArrays(1, &slot.vao);
-      GLuint buffers[3];
-      glGenBuffers(3, buffers);
+      GLuint buffers[4];
+      glGenBuffers(4, buffers);
       slot.positions = buffers[0];
       slot.normals = buffers[1];
       slot.indices = buffers[2];
+      slot.pieces = buffers[3];
       glBindVertexArray(slot.vao);
       glBindBuffer(GL_ARRAY_BUFFER, slot.positions);
       glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
@@ -291,6 +297,8 @@ struct Renderer::Impl {
       glBindBuffer(GL_ARRAY_BUFFER, slot.normals);
       glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
       glEnableVertexAttribArray(1);
+      glBindBuffer(GL_ARRAY_BUFFER, slot.pieces);
+      glVertexAttribPointer(2, 1, GL_UNSIGNED_BYTE, GL_FALSE, 0, nullptr);
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, slot.indices);
       glBindVertexArray(0);
       bodies.push_back(std::move(slot));
@@ -308,6 +316,17 @@ struct Renderer::Impl {
       capacity = slot.vertex_capacity * sizeof(float);
       upload(GL_ARRAY_BUFFER, slot.normals, slot.normal.data(), bytes, capacity, stats);
       slot.vertex_capacity = capacity / sizeof(float);
+      // A fragmented lens's pieces (attribute 2; without them, or with a count that is not the
+      // vertices', the attribute reads 0).
+      glBindVertexArray(slot.vao);
+      if (b.piece.empty() || b.piece.size() != b.xyz.size() / 3) {
+        glDisableVertexAttribArray(2);
+      } else {
+        upload(GL_ARRAY_BUFFER, slot.pieces, b.piece.data(), b.piece.size(), slot.piece_capacity,
+               stats);
+        glEnableVertexAttribArray(2);
+      }
+      glBindVertexArray(0);
       if (b.topology_version != slot.topology_version) {
         glBindVertexArray(slot.vao);  // the element buffer binding is VAO state
         const std::vector<uint32_t>& tris = b.look == Look::Sclera ? sclera_outside(b) : b.tris;
@@ -320,6 +339,7 @@ struct Renderer::Impl {
         slot.topology_version = b.topology_version;
       }
     }
+    lens_map->update(s, stats);
   }
 
   // Inside this radius the globe's front belongs to the cornea and the iris under it; up to the
@@ -473,6 +493,8 @@ struct Renderer::Impl {
       set_float(program, "u_globe_r", globe_r);
       glUniform1i(glGetUniformLocation(program, "u_texture"), 0);
     }
+    for (Look look : {Look::LensSurface, Look::LensInterior})
+      lens_map->bind(body_programs[static_cast<int>(look)], 1);
     glActiveTexture(GL_TEXTURE0);
 
     auto draw_body = [&](size_t i) {
@@ -482,6 +504,9 @@ struct Renderer::Impl {
       glUseProgram(body_programs[static_cast<int>(look)]);
       if (look == Look::Iris) glBindTexture(GL_TEXTURE_2D, iris_texture);
       if (look == Look::Sclera) glBindTexture(GL_TEXTURE_2D, sclera_texture);
+      if (look == Look::LensSurface || look == Look::LensInterior)
+        set_float(body_programs[static_cast<int>(look)], "u_reflex_mu",
+                  s.bodies[i].reflex_attenuation_per_mm);
       // Closed bodies show only their outside; open membranes both sides.
       const bool closed = look == Look::Sclera || look == Look::LensSurface || look == Look::Cornea;
       if (closed) glEnable(GL_CULL_FACE);
@@ -505,6 +530,7 @@ struct Renderer::Impl {
     for (Look look : {Look::LensInterior, Look::LensSurface, Look::Iris, Look::Sclera})
       for (size_t i = 0; i < s.bodies.size(); ++i)
         if (s.bodies[i].look == look) draw_body(i);
+    lens_map->draw_fundus(body_programs[static_cast<int>(Look::LensSurface)], stats);
 
     // 3. Shadows: blended once per pixel (stencil), only where tissue is in front of nothing.
     glEnable(GL_BLEND);
@@ -582,6 +608,7 @@ Renderer::Renderer(const RenderOptions& options) : impl_(new Impl), options_(opt
       const std::string name = "body look " + std::to_string(look);
       im.body_programs[look] = link(shaders::kBodyVertex, fragment.c_str(), name.c_str());
     }
+    im.lens_map = std::make_unique<LensReflexMap>();
     im.shadow_program = link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow");
     im.overlay_program = link(shaders::kOverlayVertex, shaders::kOverlayFragment, "overlay");
     im.iris_polar[0] = make_iris_texture(false);
@@ -620,8 +647,8 @@ Renderer::~Renderer() {
   glDeleteTextures(1, &im.sclera_texture);
   for (auto& slot : im.bodies) {
     glDeleteVertexArrays(1, &slot.vao);
-    const GLuint buffers[3] = {slot.positions, slot.normals, slot.indices};
-    glDeleteBuffers(3, buffers);
+    const GLuint buffers[4] = {slot.positions, slot.normals, slot.indices, slot.pieces};
+    glDeleteBuffers(4, buffers);
   }
   for (auto* slot : {&im.tool_bodies[0], &im.tool_bodies[1], &im.tool_bodies[2], &im.tool_bodies[3],
                      &im.tool_bodies[4], &im.tool_bodies[5], &im.tool_jaw}) {
@@ -630,6 +657,7 @@ Renderer::~Renderer() {
   }
   glDeleteVertexArrays(1, &im.overlay_vao);
   glDeleteBuffers(1, &im.overlay_vbo);
+  im.lens_map.reset();
   delete impl_;
 }
 

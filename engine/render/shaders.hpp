@@ -11,14 +11,17 @@ constexpr int kLookCount = 7;
 inline constexpr const char* kBodyVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
+layout(location = 2) in float a_piece;  // lens: which fragment (BodyView::piece); else 0
 uniform mat4 u_model;      // body or instrument frame -> eye frame after globe rotation
 uniform mat4 u_view_proj;
 out vec3 v_local;          // body frame (eye frame before globe rotation) or instrument frame
 out vec3 v_world;
 out vec3 v_normal;
+flat out float v_piece;
 void main() {
   vec4 w = u_model * vec4(a_pos, 1.0);
   v_local = a_pos;
+  v_piece = a_piece;
   v_world = w.xyz;
   v_normal = mat3(u_model) * a_normal;
   gl_Position = u_view_proj * w;
@@ -42,6 +45,34 @@ uniform vec3 u_tool_colour;
 uniform float u_glow;       // phaco tip ultrasound glow 0..1
 uniform float u_glow_length;
 out vec4 o_colour;
+
+#if LOOK == 4 || LOOK == 5
+// The lens seen from the microscope (lens_reflex.hpp): light from the fundus returns through the
+// lens, dimmed by exp(-u_reflex_mu t) where t is the lens's remaining thickness on the line
+// through this point; the rest of what the eye sees is the illuminator's light scattered back by
+// the cataract's nucleus (amber), lit by the top surface's normal. So a trench's floor glows
+// brighter and redder as the nucleus under it thins: the depth cue surgeons sculpt by.
+uniform sampler2D u_lens_map;  // r: thickness mm; g, b: top normal x, y; a: 1 on the lens
+uniform vec2 u_lens_map_origin;
+uniform float u_lens_map_span;
+uniform float u_reflex_mu;     // 1/mm (0: a clear lens)
+uniform mat4 u_model;          // the globe's rotation (turns the map's normal into the eye frame)
+flat in float v_piece;
+vec4 lens_map(vec2 xy) {
+  return texture(u_lens_map, (xy - u_lens_map_origin) / u_lens_map_span);
+}
+// lit: the illuminator's light on the surface, 0..1; facing: the surface normal's z (body frame).
+vec3 lens_colour(float thickness, float lit, float facing, float k) {
+  vec3 reflex = mix(vec3(0.42, 0.05, 0.02), vec3(0.98, 0.40, 0.12), k);
+  // A steep face (a trench's wall) bends the fundus's light away from the microscope: its reflex
+  // dims, so both walls outline the glowing floor.
+  float through = exp(-u_reflex_mu * thickness) * mix(0.45, 1.0, facing);
+  // Fragments apart: each piece's nucleus a shade lighter or darker than its neighbours.
+  float tint = 0.86 + 0.28 * fract(v_piece * 0.618034);
+  vec3 haze = tint * vec3(0.36, 0.23, 0.04) * (0.25 + 0.75 * lit);
+  return reflex * through + haze * (1.0 - through);
+}
+#endif
 
 void main() {
   vec3 n = normalize(v_normal);
@@ -79,14 +110,22 @@ void main() {
   float highlight = pow(nh, 60.0);
   o_colour = vec4(0.86, 0.9, 0.95, clamp(0.16 + 0.5 * highlight, 0.0, 1.0));
   return;
-#elif LOOK == 4  // lens lit from behind by the fundus: the red reflex, brightest on the axis
+#elif LOOK == 4 || LOOK == 5  // the lens: red reflex from behind, brightest on the axis
   float k = clamp(1.0 - 0.6 * dot(v_local.xy, v_local.xy) / (u_pupil_r * u_pupil_r), 0.0, 1.0);
-  c = mix(vec3(0.42, 0.05, 0.02), vec3(0.98, 0.40, 0.12), k) + 0.15 * pow(nh, 80.0);
+  vec4 map = lens_map(v_local.xy);
+  float lit = diffuse, facing = 1.0;
+#if LOOK == 5
+  // Sculpted faces take the sculpted surface's normal (the map's, at the trench's scale, not the
+  // tets' facets), so the walls read as walls (eye frame, as the illuminator is). No glint: on
+  // the floor's tet-sized bumps it would only sparkle.
+  if (map.a > 0.5) {
+    facing = sqrt(max(1.0 - dot(map.gb, map.gb), 0.0));
+    lit = max(dot(mat3(u_model) * vec3(map.gb, facing), u_to_light), 0.0);
+  }
+  nh = 0.0;
+#endif
+  c = lens_colour(map.r, lit, facing, k) + 0.15 * pow(nh, 80.0);
   mean = c;
-#elif LOOK == 5  // exposed nucleus: pale yellow, lit so trench walls read darker than its floor
-  vec3 albedo = vec3(0.86, 0.77, 0.50);
-  c = albedo * (0.25 + 0.75 * diffuse) + vec3(0.12, 0.02, 0.0);
-  mean = albedo * 0.7;
 #else  // instruments: polished steel
   c = u_tool_colour * (0.35 + 0.6 * diffuse) + vec3(0.55) * pow(nh, 40.0);
   float glow = u_glow * clamp(1.0 - v_local.z / u_glow_length, 0.0, 1.0);

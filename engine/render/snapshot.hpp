@@ -34,6 +34,13 @@ struct BodyView {
   std::vector<uint32_t> tris;     // 3 per triangle, indices into xyz / 3
   std::vector<uint32_t> edges;    // 2 per open (cut or rim) edge to outline; may be empty
   uint64_t topology_version = 0;  // changes whenever tris/edges change: re-upload indices then
+  // Lens looks only (issue 19 item 4). How much each mm of this lens dims the red reflex seen
+  // through it (1/mm; 0 = a clear lens, the reflex as bright as the fundus gives it): a cataract's
+  // nucleus, the harder the darker, so the reflex brightens where sculpting thinned it.
+  float reflex_attenuation_per_mm = 0;
+  // Per vertex, which piece of a fragmented lens it belongs to (the fragment's id, wrapped to a
+  // byte; the shader tints pieces apart); empty = one piece.
+  std::vector<uint8_t> piece;
 };
 
 struct ToolView {

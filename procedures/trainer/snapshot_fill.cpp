@@ -48,7 +48,19 @@ struct SnapshotFillCache {
   std::vector<uint8_t> face_was_external;         // fragments lens, per face id, at first fill
   std::vector<Vec3> ports;                        // guidance ports when no ports record
   bool ports_made = false;
+  float reflex_attenuation = -1;  // lens, 1/mm; set at the first fill
 };
+
+// How much each mm of the sculptable lens dims the red reflex (render::BodyView): a harder, browner
+// nucleus dims it more. At the standard hardness 0.5 the intact lens (4.5 mm on the axis) passes
+// exp(−0.4 × 4.5) ≈ 17 % of the reflex and a trench floor 1.5 mm above the posterior pole ≈ 55 %:
+// the floor glows as the trench deepens (issue 19 item 4). The rhexis drill's lens_surface stays
+// clear (0): there the reflex is what shows the capsule's flap.
+float reflex_attenuation(const Scene& scene) {
+  const auto it = scene.params.values.find("lens_model.nucleus_hardness");
+  const double hardness = it == scene.params.values.end() ? 0.5 : it->second;
+  return static_cast<float>(0.2 + 0.4 * std::clamp(hardness, 0.0, 1.0));
+}
 
 uint64_t fnv(uint64_t h, std::span<const uint32_t> v) {
   for (uint32_t x : v) {
@@ -188,11 +200,34 @@ void fill_tet_lens(BodyView& outer, BodyView& inner, const Particles& p, const T
   }
   compact_faces(outer, cache.faces, p.x, p.y, p.z, cache);
   compact_faces(inner, cache.interior, p.x, p.y, p.z, cache);
+  outer.piece.clear(), inner.piece.clear();  // one piece
+}
+
+// Each vertex's fragment, wrapped to a byte, so the renderer tints the pieces apart: a face node's
+// cell's label; a ring centre (no face of its own) takes that of a face node of its triangles.
+// Call right after compact_faces: cache.touched lists the view's nodes in their compacted order.
+void fill_pieces(BodyView& v, const simplex::BoundarySurface& s, std::span<const uint32_t> labels,
+                 const SnapshotFillCache& cache) {
+  constexpr uint8_t kUnknown = 0xFF;
+  v.piece.assign(cache.touched.size(), kUnknown);
+  for (size_t m = 0; m < cache.touched.size(); ++m) {
+    const uint32_t node = cache.touched[m];
+    const uint32_t face = node < s.node_face.size() ? s.node_face[node] : kNoSimplex;
+    const uint32_t cell = face == kNoSimplex ? kNoSimplex : simplex_face_cell(face);
+    if (cell < labels.size() && labels[cell] != kNoSimplex)
+      v.piece[m] = static_cast<uint8_t>(labels[cell] % kUnknown);
+  }
+  for (size_t t = 0; t + 2 < v.tris.size(); t += 3)
+    for (int k = 0; k < 3; ++k) {
+      uint8_t& p = v.piece[v.tris[t + k]];
+      if (p != kUnknown) continue;
+      for (int j = 1; j < 3 && p == kUnknown; ++j) p = v.piece[v.tris[t + (k + j) % 3]];
+    }
 }
 
 // The fragmenting lens: the simplex boundary surface (nodes at the external faces' centres).
 void fill_fragment_lens(BodyView& outer, BodyView& inner, const SimplexCells& cells,
-                        SnapshotFillCache& cache) {
+                        std::span<const uint32_t> labels, SnapshotFillCache& cache) {
   const uint32_t faces = cells.size() * 4;
   if (cache.face_was_external.size() != faces) {
     cache.face_was_external.assign(faces, 0);
@@ -213,7 +248,9 @@ void fill_fragment_lens(BodyView& outer, BodyView& inner, const SimplexCells& ce
     (original ? cache.faces : cache.interior).push_back(tri);
   }
   compact_faces(outer, cache.faces, s.x, s.y, s.z, cache);
+  fill_pieces(outer, s, labels, cache);
   compact_faces(inner, cache.interior, s.x, s.y, s.z, cache);
+  fill_pieces(inner, s, labels, cache);
 }
 
 void fill_guidance(Scene& scene, render::RenderSnapshot& snap, SnapshotFillCache& cache) {
@@ -280,12 +317,14 @@ void fill_snapshot(Scene& scene, render::RenderSnapshot& snap) {
       BodyView& inner = view_at(snap, *cache, b, "lens.interior", Look::LensInterior);
       BodyView& outer = view_at(snap, *cache, a, name, Look::LensSurface);
       if (const LensFragments* lf = w.get<LensFragments>(e)) {
-        fill_fragment_lens(outer, inner, lf->lens.cells, *cache);
+        fill_fragment_lens(outer, inner, lf->lens.cells, lf->lens.fragments.label, *cache);
       } else if (const LensSculpting* ls = w.get<LensSculpting>(e)) {
         fill_tet_lens(outer, inner, w.at<Particles>(e), ls->topology, *cache);
       } else {
         outer.xyz.clear(), outer.tris.clear(), inner.xyz.clear(), inner.tris.clear();
       }
+      if (cache->reflex_attenuation < 0) cache->reflex_attenuation = reflex_attenuation(scene);
+      outer.reflex_attenuation_per_mm = inner.reflex_attenuation_per_mm = cache->reflex_attenuation;
       finish_view(outer, cache->views[a], false, *cache);
       finish_view(inner, cache->views[b], false, *cache);
       continue;

@@ -12,6 +12,9 @@
 //             by sculpting (a live tet whose neighbour across the face was removed; LensInterior);
 //   lens (simplex cells, seed 002 §5.2) → the boundary surface of systems/simplex; triangles whose
 //             face nodes all were external at the first fill → "lens", the rest → "lens.interior".
+//             Each vertex carries its fragment (BodyView::piece) so the pieces show apart.
+//   Both lens models: reflex_attenuation_per_mm from the nucleus hardness (a cataract dims the red
+//             reflex; the renderer brightens it where sculpting thinned the lens, issue 19 item 4).
 // topology_version changes whenever a view's triangles or edges change (a 64-bit hash of them
 // compared with the last fill's); versions come from one process-wide counter, so a rebuilt scene
 // never repeats a version the renderer has cached. Tools: pose, kind, hand, grip, pedal;

@@ -4,7 +4,9 @@
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
@@ -16,7 +18,9 @@
 #include "engine/render/renderer.hpp"
 #include "procedures/eye/eye_geometry.hpp"
 #include "procedures/eye/eye_mesh.hpp"
+#include "tests/support/box_body.hpp"
 #include "tests/support/environment.hpp"
+#include "tests/support/gl_window.hpp"
 
 namespace phaco::render {
 namespace {
@@ -95,15 +99,8 @@ std::vector<uint32_t> open_edges(const std::vector<uint32_t>& tris) {
 class RendererTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    if (!std::getenv("DISPLAY")) return;
-    if (!glfwInit()) return;
-    glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-    window_ = glfwCreateWindow(64, 64, "test_renderer", nullptr, nullptr);
+    window_ = test::make_hidden_gl_window("test_renderer");
     if (!window_) return;
-    glfwMakeContextCurrent(window_);
     const eye::EyeParams params = eye::default_eye_params();
     const eye::Resolution res = eye::resolution_for_level(1);
     geometry_ = new eye::EyeGeometry(eye::eye_geometry(params));
@@ -121,15 +118,10 @@ class RendererTest : public ::testing::Test {
     delete eye_;
     delete geometry_;
     eye_ = nullptr;
-    if (window_) glfwDestroyWindow(window_);
-    window_ = nullptr;
-    glfwTerminate();
+    test::close_gl_window(window_);
   }
   void SetUp() override {
-    PHACO_REQUIRE_ENVIRONMENT(std::getenv("DISPLAY") != nullptr,
-                              "no X display ($DISPLAY unset): run under xvfb-run");
-    PHACO_REQUIRE_ENVIRONMENT(window_ != nullptr,
-                              "no OpenGL 3.3 core context from GLFW on this display");
+    PHACO_REQUIRE_GL_WINDOW(window_);
     target_ = std::make_unique<OffscreenTarget>(kW, kH);
   }
 
@@ -187,26 +179,86 @@ TEST_F(RendererTest, RedReflexFillsThePupilAndNotTheIris) {
             img.at(static_cast<int>(c[0] + 0.8 * pupil_px), static_cast<int>(c[1]))[0]);
 }
 
-TEST_F(RendererTest, ExposedNucleusIsPaleYellowWhereTheReflexIsRed) {
-  // The sculpted lens: its exposed interior (here the whole nucleus, the cortex and capsule
-  // gone) reads pale yellow, not red, so a trench stands out from the red reflex around it.
+TEST_F(RendererTest, ACataractDimsTheReflexByTheLensThicknessOnTheLine) {
+  // A cataract's lens (reflex_attenuation_per_mm > 0) passes less of the fundus's light the
+  // thicker it is where one looks: the same lens made thinner glows brighter and redder; a clear
+  // lens (0, the default) keeps the full reflex. Sculpting relies on it (issue 19 item 4).
+  Renderer r(plain());
+  const auto c = px(Vec3::Zero());
+  const int x = static_cast<int>(c[0]), y = static_cast<int>(c[1] + 0.8 * px_per_mm());
+  auto centre = [&](const RenderSnapshot& s) {
+    const Image img = render(r, s);
+    const uint8_t* p = img.at(x, y);  // below the illuminator's reflection
+    return std::array<uint8_t, 3>{p[0], p[1], p[2]};
+  };
+  auto without_capsule = [&](double attenuation, float z_scale) {
+    RenderSnapshot s = *eye_;
+    std::erase_if(s.bodies, [](const BodyView& b) { return b.look == Look::Capsule; });
+    for (BodyView& b : s.bodies)
+      if (b.look == Look::LensSurface) {
+        b.reflex_attenuation_per_mm = static_cast<float>(attenuation);
+        for (size_t i = 2; i < b.xyz.size(); i += 3) b.xyz[i] *= z_scale;
+      }
+    return s;
+  };
+  auto brightness = [](const std::array<uint8_t, 3>& p) { return p[0] + p[1] + p[2]; };
+  auto red = [](const std::array<uint8_t, 3>& p) { return redness(p.data()); };
+  const auto clear = centre(without_capsule(0, 1));
+  const auto cataract = centre(without_capsule(0.35, 1));
+  const auto thinned = centre(without_capsule(0.35, 0.4f));
+  EXPECT_TRUE(red_reflex(clear.data()));
+  EXPECT_FALSE(red_reflex(cataract.data()));
+  EXPECT_LT(red(cataract), red(clear) - 40);
+  EXPECT_GT(red(thinned), red(cataract) + 30);
+  EXPECT_GT(brightness(thinned), brightness(cataract) + 20);
+}
+
+TEST_F(RendererTest, AGroovesWallsAreShadedAndItsFloorGlows) {
+  // A sculpted nucleus as exact geometry: a slab and two blocks either side of a straight groove
+  // along x, 1.5 mm wide and 2 mm deep (DESIGN.md §6's trench), seen zoomed in without the
+  // membranes. The illuminator is tilted toward 12 o'clock (+y): the groove's wall facing it (on
+  // its 6 o'clock side) reads lighter than the wall facing away, all else being symmetric; the
+  // floor, with less lens under it, glows brighter and redder than the top beside.
   Renderer r(plain());
   RenderSnapshot s = *eye_;
   std::erase_if(s.bodies, [](const BodyView& b) {
-    return b.look == Look::LensSurface || b.look == Look::Capsule;
+    return b.look == Look::LensSurface || b.look == Look::Capsule || b.look == Look::Cornea;
   });
-  BodyView nucleus = eye_->bodies[2];
-  ASSERT_EQ(nucleus.look, Look::LensSurface);
+  BodyView nucleus;
+  nucleus.name = "lens.interior";
   nucleus.look = Look::LensInterior;
-  for (float& v : nucleus.xyz) v *= 0.7f;
+  nucleus.reflex_attenuation_per_mm = 0.4f;
+  nucleus.topology_version = 1;
+  test::add_box(nucleus, Vec3(-3, -3, -2.5), Vec3(3, 3, -0.5));
+  test::add_box(nucleus, Vec3(-3, -3, -0.5), Vec3(3, -0.75, 1.5));
+  test::add_box(nucleus, Vec3(-3, 0.75, -0.5), Vec3(3, 3, 1.5));
   s.bodies.push_back(nucleus);
-  const Image img = render(r, s);
-  const auto c = px(Vec3::Zero());
-  auto pale_yellow = [](const uint8_t* p) {
-    return p[0] > 120 && p[1] > 0.75 * p[0] && p[2] + 50 < p[1];
+  Microscope m;
+  m.field_mm = 6;
+  const Image img = render(r, s, m);
+  // Mean brightness and redness over x in [-2, 2] and y in [y0, y1] at height z.
+  auto strip = [&](double y0, double y1, double z) {
+    const auto a = px(Vec3(-2, y1, z), m), b = px(Vec3(2, y0, z), m);
+    double bright = 0, red = 0;
+    int n = 0;
+    for (int y = static_cast<int>(a[1]); y <= static_cast<int>(b[1]); ++y)
+      for (int x = static_cast<int>(a[0]); x <= static_cast<int>(b[0]); ++x, ++n) {
+        const uint8_t* p = img.at(x, y);
+        bright += p[0] + p[1] + p[2];
+        red += redness(p);
+      }
+    return std::array<double, 2>{bright / n, red / n};
   };
-  EXPECT_GT(img.fraction(c[0], c[1], 2.0 * px_per_mm(), pale_yellow), 0.8);
-  EXPECT_LT(img.fraction(c[0], c[1], 2.0 * px_per_mm(), red_reflex), 0.05);
+  const auto lit_wall = strip(-0.85, -0.65, 1.5), dark_wall = strip(0.65, 0.85, 1.5);
+  const auto floor = strip(-0.3, 0.3, -0.5), top = strip(-2.0, -1.4, 1.5);
+  std::printf(
+      "groove: wall facing the light %.1f, facing away %.1f; floor %.1f (redness %.1f), "
+      "top %.1f (%.1f)\n",
+      lit_wall[0], dark_wall[0], floor[0], floor[1], top[0], top[1]);
+  EXPECT_GT(lit_wall[0], dark_wall[0] + 20)
+      << "wall facing the light " << lit_wall[0] << ", facing away " << dark_wall[0];
+  EXPECT_GT(floor[0], top[0] + 30) << "floor " << floor[0] << ", top " << top[0];
+  EXPECT_GT(floor[1], top[1] + 20) << "floor " << floor[1] << ", top " << top[1];
 }
 
 TEST_F(RendererTest, CapsulorhexisOpeningShowsMoreRedThanTheIntactCapsule) {
@@ -400,7 +452,9 @@ TEST_F(RendererTest, IndexBuffersAreSentOnlyWhenTopologyChanges) {
   const FrameStats first = r.draw(s, {}, kW, kH);
   const FrameStats second = r.draw(s, {}, kW, kH);
   EXPECT_GT(second.triangles, 1000u);
-  EXPECT_EQ(first.uploads, second.uploads + s.bodies.size());  // one index buffer per body
+  // One index buffer per body, and the lens's thickness map (sent again only when the lens
+  // changes).
+  EXPECT_EQ(first.uploads, second.uploads + s.bodies.size() + 1);
   s.bodies[3].topology_version++;
   const FrameStats third = r.draw(s, {}, kW, kH);
   EXPECT_EQ(third.uploads, second.uploads + 1);
