@@ -202,6 +202,31 @@ void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   });
 }
 
+constexpr double kRestOverlapMm = 0.35;
+
+// Cells more than `leash_mm` out of the bag (the opening allowed) are moved back to `leash_mm` out
+// along the way to their projection (lens_tools::constrain on the one cell).
+void leash_to_bag(FragmentLens& l, double leash_mm) {
+  const lens_tools::EyeBounds& b = l.settings.bounds;
+  for (uint32_t c = 0; c < l.cells.size(); ++c) {
+    if (!l.cells.alive[c]) continue;
+    const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+    if (lens_tools::inside_bounds(p, b, leash_mm)) continue;
+    float x = l.cells.x[c], y = l.cells.y[c], z = l.cells.z[c], vx = 0, vy = 0, vz = 0;
+    const float mass = l.cells.mass[c], hardness = 0;
+    const uint8_t alive = 1;
+    const CellSpans one{{&x, 1},  {&y, 1},    {&z, 1},     {&vx, 1},      {&vy, 1},
+                        {&vz, 1}, {&mass, 1}, {&alive, 1}, {&hardness, 1}};
+    lens_tools::constrain(one, b, {});
+    const Vec3 q(x, y, z), out = p - q;
+    const double len = out.norm();
+    if (!(len > leash_mm)) continue;
+    const Vec3 r = q + out * (leash_mm / len);
+    l.cells.x[c] = static_cast<float>(r.x()), l.cells.y[c] = static_cast<float>(r.y()),
+    l.cells.z[c] = static_cast<float>(r.z());
+  }
+}
+
 // Ultrasound on a held fragment: the vacuum draws it into the port as fast as the tip emulsifies
 // it (lens_tools/fluidics.hpp, emulsify_rate_mm3_s at full power): its cells nearest the port,
 // within two port radii of it, go first, each costing its volume / (1 − hardness) of the step's
@@ -389,9 +414,11 @@ FragmentLensStats step_fragment_lens(FragmentLens& l, const LensTools& tools, co
   lens_tools::constrain(cells, l.settings.bounds, l.contact);
   match_shapes(l, st, dt_s);
   // The rigid fit can set a cell back out of the bag (by over a millimetre when a crack's halves
-  // push apart against the wall); with fluidics (the drill that fails on a capsule breach) the
-  // bag has the last word, so no cell ends a step through its wall.
-  if (fluidics) lens_tools::constrain(cells, l.settings.bounds, {});
+  // push apart against the wall). With fluidics (the drill that fails on a capsule breach) a cell
+  // the fit left further out than the lens at rest stands out of the bag (its shoulders, up to
+  // 0.33 mm with the equator fit, constraints.hpp) is brought back to that distance: fragments
+  // never leave through the wall, and the resting lens is not squeezed.
+  if (fluidics) leash_to_bag(l, kRestOverlapMm);
   return st;
 }
 
