@@ -48,15 +48,6 @@ PortCover port_cover(const CellSpans& cells, std::span<const float> volume,
   const double sphere = 4.0 / 3.0 * M_PI * std::pow(s.port_radius_mm, 3);
   out.fraction = best / sphere;
   out.occluded = out.fraction >= s.occlusion_fraction;
-  Vec3 sum = Vec3::Zero();
-  uint32_t count = 0;
-  for (uint32_t i = 0; i < cells.size(); ++i) {
-    if (!cells.alive[i] || label[i] != out.fragment) continue;
-    const Vec3f x(cells.x[i], cells.y[i], cells.z[i]);
-    if ((x - p).squaredNorm() > r2) continue;
-    sum += x.cast<double>(), ++count;
-  }
-  out.centre = sum / double(std::max(count, 1u));
   return out;
 }
 

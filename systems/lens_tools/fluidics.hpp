@@ -68,7 +68,6 @@ double holding_force_mn(double vacuum_mmhg, const FluidicsSettings& s);
 struct PortCover {
   uint32_t fragment = 0xffffffffu;  // the fragment filling most of the port
   double fraction = 0;              // its covered fraction of the port sphere's volume
-  Vec3 centre = Vec3::Zero();       // mean of its cells inside the port, mm
   bool occluded = false;
 };
 
