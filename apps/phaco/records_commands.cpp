@@ -30,6 +30,8 @@ const std::vector<std::string>& key_metrics(const std::string& drill) {
        {"rhexis.diameter_mm", "rhexis.circularity", "rhexis.centering_mm", "rhexis.radial_tearouts",
         "time_s"}},
       {"phaco_sculpting", {"trench.depth_fraction", "trench.width_mm", "capsule_breach", "time_s"}},
+      {"nucleus_removal",
+       {"volume_removed_fraction", "cde_pct_s", "posterior_capsule.rupture", "time_s"}},
   };
   static const std::vector<std::string> kDefault = {"time_s"};
   const auto it = kKeys.find(drill);

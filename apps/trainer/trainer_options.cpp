@@ -24,7 +24,8 @@ usage:
   phaco-trainer ... --soak OUT.json [--soak-for SECONDS]
   phaco-trainer --help
 
-  --drill       corneal_incision | capsulorhexis | phaco_sculpting (default capsulorhexis); the
+  --drill       corneal_incision | capsulorhexis | phaco_sculpting | nucleus_removal (default
+                capsulorhexis); the
                 tools start where the drill's expert scenario starts them
   --scenario    any scenario file instead (its tracks give the tools and start poses)
   --difficulty  a level of the drill file (data/drills/<drill>.json: standard, easy, hard, ...)
@@ -73,10 +74,13 @@ std::filesystem::path drill_scenario(const std::string& drill) {
   const std::string name = drill == "incision"    ? "corneal_incision"
                            : drill == "rhexis"    ? "capsulorhexis"
                            : drill == "sculpting" ? "phaco_sculpting"
+                           : drill == "nucleus"   ? "nucleus_removal"
                                                   : drill;
-  if (name != "corneal_incision" && name != "capsulorhexis" && name != "phaco_sculpting") {
+  if (name != "corneal_incision" && name != "capsulorhexis" && name != "phaco_sculpting" &&
+      name != "nucleus_removal") {
     throw InputError("--drill: unknown drill '" + drill +
-                     "'; expected corneal_incision, capsulorhexis or phaco_sculpting");
+                     "'; expected corneal_incision, capsulorhexis, phaco_sculpting or "
+                     "nucleus_removal");
   }
   return eye::data_dir() / "scenarios" / (name + "_expert.json");
 }

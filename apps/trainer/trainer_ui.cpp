@@ -19,15 +19,15 @@ namespace phaco::trainer {
 
 namespace {
 
-constexpr std::array<const char*, 3> kDrills = {"corneal_incision", "capsulorhexis",
-                                                "phaco_sculpting"};
+constexpr std::array<const char*, 4> kDrills = {"corneal_incision", "capsulorhexis",
+                                                "phaco_sculpting", "nucleus_removal"};
 constexpr std::array<const char*, 3> kDevices = {"desktop", "scripted", "track"};
 
 // Events a trainee must notice at once (seed 004: warn before the tear runs out).
 bool is_warning(const std::string& kind) {
   return kind == "runout_warning" || kind == "radial_tearout" || kind == "capsule_breach" ||
-         kind == "corneal_stress" || kind == "port_stress" || kind == "iris_contact" ||
-         kind == "lens_contact";
+         kind == "posterior_capsule_rupture" || kind == "corneal_stress" || kind == "port_stress" ||
+         kind == "iris_contact" || kind == "lens_contact";
 }
 
 int index_of(const std::vector<std::string>& names, const std::string& name) {

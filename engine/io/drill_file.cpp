@@ -47,7 +47,8 @@ class DrillParser {
     const auto parsed = parse_drill(r_.string(drill, "drill"));
     if (!parsed) {
       r_.fail("drill", "unknown drill '" + drill.get<std::string>() +
-                           "'; expected one of: corneal_incision, capsulorhexis, phaco_sculpting");
+                           "'; expected one of: corneal_incision, capsulorhexis, phaco_sculpting, "
+                           "nucleus_removal");
     }
     d.drill = *parsed;
     d.title = r_.string(r_.require(root, "$", "title", "a title"), "title");
@@ -130,7 +131,7 @@ class DrillParser {
         if (!tool) {
           r_.fail(ipath, "unknown tool '" + a[i].get<std::string>() +
                              "'; expected one of: forceps, keratome, cystotome, phaco_probe, "
-                             "hook, aspirator");
+                             "hook, aspirator, chopper");
         }
         out.push_back(*tool);
       }

@@ -25,10 +25,10 @@ using io::path_index;
 using io::path_key;
 
 // Names in enum order: the enum value is the index.
-constexpr std::array<std::string_view, 3> kDrillNames{"corneal_incision", "capsulorhexis",
-                                                      "phaco_sculpting"};
-constexpr std::array<std::string_view, 6> kToolNames{"forceps",     "keratome", "cystotome",
-                                                     "phaco_probe", "hook",     "aspirator"};
+constexpr std::array<std::string_view, 4> kDrillNames{"corneal_incision", "capsulorhexis",
+                                                      "phaco_sculpting", "nucleus_removal"};
+constexpr std::array<std::string_view, 7> kToolNames{
+    "forceps", "keratome", "cystotome", "phaco_probe", "hook", "aspirator", "chopper"};
 constexpr std::array<std::string_view, 2> kHandNames{"left", "right"};
 constexpr std::array<std::string_view, 2> kCapsuleLayouts{"curvilinear", "isotropic"};
 constexpr std::array<std::string_view, 5> kMeshBodies{"cornea", "capsule", "iris", "globe",

@@ -18,8 +18,16 @@
 
 namespace phaco {
 
-enum class Drill : uint8_t { CornealIncision, Capsulorhexis, PhacoSculpting };
-enum class ToolKind : uint8_t { Forceps, Keratome, Cystotome, PhacoProbe, Hook, Aspirator };
+enum class Drill : uint8_t { CornealIncision, Capsulorhexis, PhacoSculpting, NucleusRemoval };
+enum class ToolKind : uint8_t {
+  Forceps,
+  Keratome,
+  Cystotome,
+  PhacoProbe,
+  Hook,
+  Aspirator,
+  Chopper
+};
 enum class Hand : uint8_t { Left, Right };
 
 std::string_view to_string(Drill drill);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "engine/schedule/parallel.hpp"
 #include "systems/sph/environment.hpp"
@@ -81,9 +82,21 @@ void mark_boundary(FragmentLens& l) {
   }
 }
 
+// A new fragment starts from the rotation of the fragment it came from (no jump): l.fragment_of
+// holds the labels before the change.
+void carry_rotations(FragmentLens& l) {
+  std::vector<Quat> rotations(l.fragments.count, Quat::Identity());
+  for (uint32_t f = 0; f < l.fragments.count; ++f) {
+    const uint32_t first = l.fragments.members[l.fragments.offsets[f]];
+    const uint32_t old = l.fragment_of[first];
+    if (old < l.rotations.size()) rotations[f] = l.rotations[old];
+  }
+  l.rotations.swap(rotations);
+  l.max_fragments = std::max(l.max_fragments, l.fragments.count);
+}
+
 }  // namespace
 
-// A new fragment starts from the rotation of the fragment it came from (no jump).
 void remove_lens_cells(FragmentLens& l, std::span<const uint32_t> cells, FragmentLensStats& st) {
   if (cells.empty()) return;
   l.awake = true;
@@ -103,14 +116,27 @@ void remove_lens_cells(FragmentLens& l, std::span<const uint32_t> cells, Fragmen
   const simplex::FragmentUpdate u =
       simplex::update_fragments(l.cells, l.removals, l.fragments, l.fragment_scratch);
   st.relabelled = u.relabelled;
-  std::vector<Quat> rotations(l.fragments.count, Quat::Identity());
-  for (uint32_t f = 0; f < l.fragments.count; ++f) {
-    const uint32_t first = l.fragments.members[l.fragments.offsets[f]];
-    const uint32_t old = l.fragment_of[first];
-    if (old < l.rotations.size()) rotations[f] = l.rotations[old];
-  }
-  l.rotations.swap(rotations);
-  l.max_fragments = std::max(l.max_fragments, l.fragments.count);
+  carry_rotations(l);
+}
+
+uint32_t crack_lens(FragmentLens& l, std::span<const std::pair<uint32_t, uint32_t>> links) {
+  uint32_t broken = 0;
+  for (const auto& [cell, face] : links) broken += simplex::break_link(l.cells, cell, face);
+  if (broken == 0) return 0;
+  l.awake = true;
+  l.fragment_of = l.fragments.label;
+  simplex::label_fragments_painting(l.cells, l.fragments, l.fragment_scratch);
+  carry_rotations(l);
+  l.links_broken += broken;
+  ++l.cracks;
+  return broken;
+}
+
+double alive_mass_kg(const FragmentLens& l) {
+  double m = 0;
+  for (uint32_t c = 0; c < l.cells.size(); ++c)
+    if (l.cells.alive[c]) m += l.cells.mass[c];
+  return m;
 }
 
 namespace {
@@ -141,6 +167,7 @@ void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   for (uint32_t c = 0; c < n; ++c) {
     if (!l.cells.alive[c] || l.cells.mass[c] <= 0) continue;
     if (l.fx[c] == 0.0f && l.fy[c] == 0.0f && l.fz[c] == 0.0f) continue;
+    if (l.fragments.label[c] == l.held_fragment) continue;  // the tip carries it: others give way
     Vec3f d = Vec3f(l.fx[c], l.fy[c], l.fz[c]) * (dt2 / l.cells.mass[c]);  // mN·s²/kg = mm
     if (d.norm() > max_move) d *= max_move / d.norm();
     l.cells.x[c] += d.x(), l.cells.y[c] += d.y(), l.cells.z[c] += d.z();
@@ -154,7 +181,10 @@ void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
       l.current[c] = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
-      l.match_mass[c] = sph::heavy_weight(l.cells.mass[c], l.contact[c] | l.pushed[c]);
+      // The held fragment goes where the tip takes it, through the other fragments (it is not
+      // pushed), but not through the bag: its cells the bag moved stay heavy.
+      const bool held = l.fragments.label[c] == l.held_fragment;
+      l.match_mass[c] = sph::heavy_weight(l.cells.mass[c], l.contact[c] | (!held && l.pushed[c]));
     }
   });
   const shape_match::FragmentList list{l.fragments.offsets, l.fragments.members};
@@ -170,6 +200,127 @@ void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s) {
       l.vx[c] += d.x() * inv_dt, l.vy[c] += d.y() * inv_dt, l.vz[c] += d.z() * inv_dt;
     }
   });
+}
+
+constexpr double kRestOverlapMm = 0.35;
+
+// Cells more than `leash_mm` out of the bag (the opening allowed) are moved back to `leash_mm` out
+// along the way to their projection (lens_tools::constrain on the one cell).
+void leash_to_bag(FragmentLens& l, double leash_mm) {
+  const lens_tools::EyeBounds& b = l.settings.bounds;
+  for (uint32_t c = 0; c < l.cells.size(); ++c) {
+    if (!l.cells.alive[c]) continue;
+    const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+    if (lens_tools::inside_bounds(p, b, leash_mm)) continue;
+    float x = l.cells.x[c], y = l.cells.y[c], z = l.cells.z[c], vx = 0, vy = 0, vz = 0;
+    const float mass = l.cells.mass[c], hardness = 0;
+    const uint8_t alive = 1;
+    const CellSpans one{{&x, 1},  {&y, 1},    {&z, 1},     {&vx, 1},      {&vy, 1},
+                        {&vz, 1}, {&mass, 1}, {&alive, 1}, {&hardness, 1}};
+    lens_tools::constrain(one, b, {});
+    const Vec3 q(x, y, z), out = p - q;
+    const double len = out.norm();
+    if (!(len > leash_mm)) continue;
+    const Vec3 r = q + out * (leash_mm / len);
+    l.cells.x[c] = static_cast<float>(r.x()), l.cells.y[c] = static_cast<float>(r.y()),
+    l.cells.z[c] = static_cast<float>(r.z());
+  }
+}
+
+// Ultrasound on a held fragment: the vacuum draws it into the port as fast as the tip emulsifies
+// it (lens_tools/fluidics.hpp, emulsify_rate_mm3_s at full power): its cells nearest the port,
+// within two port radii of it, go first, each costing its volume / (1 − hardness) of the step's
+// budget (a hard nucleus takes longer, and more energy). Appended to this step's removals.
+void feed_held(FragmentLens& l, const Vec3& port, double power, double dt_s) {
+  const bool held = l.held_cell < l.cells.size() && l.cells.alive[l.held_cell];
+  if (!held) {
+    l.feed_budget_mm3 = 0;
+    return;
+  }
+  const uint32_t f = l.fragments.label[l.held_cell];
+  // What the tip could not take (nothing at the port) is not saved up beyond a few steps.
+  const double per_step = l.settings.fluid.emulsify_rate_mm3_s * power * dt_s;
+  l.feed_budget_mm3 = std::min(l.feed_budget_mm3 + per_step, 4 * per_step);
+  const float reach = static_cast<float>(2 * l.settings.fluid.port_radius_mm);
+  const Vec3f p = port.cast<float>();
+  const auto taken = [&](uint32_t c) {
+    return std::find(l.removed.begin(), l.removed.end(), c) != l.removed.end();
+  };
+  for (int guard = 0; guard < 64; ++guard) {
+    uint32_t best = kNoSimplex;
+    float best_d = std::numeric_limits<float>::infinity();
+    for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
+      const uint32_t c = l.fragments.members[k];
+      const float d = (Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - p).squaredNorm();
+      if (d < best_d && !taken(c)) best_d = d, best = c;
+    }
+    if (best == kNoSimplex || best_d > reach * reach) break;  // only what is at the port
+    const double cost = l.cells.volume[best] / std::max(1e-3, 1.0 - double(l.hardness[best]));
+    if (cost > l.feed_budget_mm3) break;
+    l.feed_budget_mm3 -= cost;
+    l.removed.push_back(best);
+    l.emulsified_mass_kg += l.cells.mass[best];
+  }
+}
+
+// The chopper and the probe pushing apart across a trench (lens_tools/crack.hpp).
+void crack(FragmentLens& l, const LensTools& tools, FragmentLensStats& st) {
+  const lens_tools::CrackCells cc{l.cells.x,     l.cells.y,  l.cells.z,
+                                  l.cells.alive, l.hardness, l.fragments.label};
+  st.push = lens_tools::push_apart(cc, *tools.probe_tip, *tools.chopper_tip, l.settings.crack,
+                                   l.crack_state);
+  if (!st.push.crack) return;
+  lens_tools::links_across(cc, l.cells.neighbour, st.push.fragment, st.push.mid, st.push.normal,
+                           l.crack_links);
+  st.links_broken = crack_lens(l, l.crack_links);
+  if (st.links_broken) l.held_fragment = kNoSimplex;  // labels changed: hold afresh
+}
+
+// Occlusion, vacuum and holding at the probe's port (lens_tools/fluidics.hpp). The held fragment
+// is known by one of its cells (the farthest from the port, the last the tip takes), since labels
+// are renumbered when cells go.
+void hold_at_port(FragmentLens& l, const LensTools& tools, FragmentLensStats& st, double dt_s) {
+  const lens_tools::FluidicsSettings& fs = l.settings.fluid;
+  lens_tools::PortCover cover;
+  if (tools.probe_tip && tools.aspirating)
+    cover = lens_tools::port_cover(spans(l), l.cells.volume, l.fragments.label, l.fragments.count,
+                                   *tools.probe_tip, fs, l.cover_scratch);
+  l.vacuum_mmhg =
+      lens_tools::step_vacuum(l.vacuum_mmhg, tools.aspirating, cover.occluded, fs, dt_s);
+  // A fragment is taken by an occluded port; once held it stays while it is still within the
+  // port's reach and the vacuum, decaying at the line's rate once the port opens, outweighs it.
+  // The fragment already held keeps the port (a crumb of it in the port does not take over).
+  uint32_t f = cover.occluded ? cover.fragment : kNoSimplex;
+  const bool was_held = l.held_cell < l.cells.size() && l.cells.alive[l.held_cell];
+  if (was_held && tools.probe_tip && tools.aspirating) f = l.fragments.label[l.held_cell];
+  l.held_fragment = kNoSimplex;
+  l.held_cell = kNoSimplex;
+  if (f != kNoSimplex) {
+    const double mass = l.fragments.mass[f];
+    const bool light = mass <= fs.max_held_mass_fraction * l.initial_mass_kg;
+    const Vec3f port = tools.probe_tip->cast<float>();
+    float nearest = std::numeric_limits<float>::infinity(), farthest = -1;
+    uint32_t far_cell = kNoSimplex, near_cell = kNoSimplex;
+    for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
+      const uint32_t c = l.fragments.members[k];
+      const float d = (Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - port).norm();
+      if (d < nearest) nearest = d, near_cell = c;
+      if (d > farthest) farthest = d, far_cell = c;
+    }
+    if (near_cell != kNoSimplex)
+      l.held_nearest = Vec3(l.cells.x[near_cell], l.cells.y[near_cell], l.cells.z[near_cell]);
+    const bool reach = nearest <= static_cast<float>(fs.hold_reach_mm);
+    if (light && reach &&
+        lens_tools::holding_force_mn(l.vacuum_mmhg, fs) > mass * fs.gravity_mm_s2) {
+      l.held_fragment = f;
+      l.held_cell = far_cell;
+      l.awake = true;
+    }
+  }
+  st.occluded = cover.occluded;
+  st.cover_fraction = cover.fraction;
+  st.held = l.held_fragment != kNoSimplex;
+  st.vacuum_mmhg = l.vacuum_mmhg;
 }
 
 }  // namespace
@@ -196,6 +347,7 @@ FragmentLens make_fragment_lens(const TetMesh& mesh, const FragmentLensSettings&
   simplex::label_fragments_painting(l.cells, l.fragments, l.fragment_scratch);
   l.rotations.assign(l.fragments.count, Quat::Identity());
   l.removed.reserve(1024);
+  l.initial_mass_kg = alive_mass_kg(l);
   return l;
 }
 
@@ -204,37 +356,69 @@ FragmentLensStats step_fragment_lens(FragmentLens& l, const LensTools& tools, co
   FragmentLensStats st;
   ++l.steps;
   const CellSpans cells = spans(l);
+  const bool fluidics = l.settings.fluidics;
+  // With fluidics the line's vacuum, not a fixed one, pulls at the port.
+  std::optional<lens_tools::Aspirator> aspirator = tools.aspirator;
+  if (fluidics && aspirator) aspirator->vacuum_mmhg = l.vacuum_mmhg;
   // 2. erosion (before the lens wakes: the first removal is what wakes it)
   l.removed.clear();
   if (tools.phaco)
     lens_tools::erode(cells, *tools.phaco, l.settings.erosion, rng, frame, dt_s, l.erosion,
                       l.removed);
-  if (tools.aspirator) {  // what reached the port is taken in
-    const Vec3f port = tools.aspirator->port.cast<float>();
-    const float r2 = static_cast<float>(l.settings.capture_mm * l.settings.capture_mm);
+  for (const uint32_t c : l.removed) l.emulsified_mass_kg += l.cells.mass[c];
+  if (aspirator) {  // what reached the port is taken in
+    const Vec3f port = aspirator->port.cast<float>();
+    // With fluidics and ultrasound on, what is emulsified in the port's lumen goes with the flow.
+    const bool lumen = fluidics && tools.phaco && tools.phaco->power > 0;
+    const double capture = lumen ? l.settings.fluid.port_radius_mm : l.settings.capture_mm;
+    const float r2 = static_cast<float>(capture * capture);
+    // With fluidics, without ultrasound only a piece that fits through the port passes it.
+    const double passes_kg = fluidics && !(tools.phaco && tools.phaco->power > 0)
+                                 ? l.settings.density_kg_mm3 * 4.0 / 3.0 * M_PI *
+                                       std::pow(l.settings.fluid.port_radius_mm, 3)
+                                 : std::numeric_limits<double>::infinity();
     const uint32_t before = static_cast<uint32_t>(l.removed.size());
     for (uint32_t c = 0; c < l.cells.size(); ++c) {
       if (!l.cells.alive[c]) continue;
       const Vec3f d = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - port;
-      if (d.squaredNorm() < r2 &&
-          !std::binary_search(l.removed.begin(), l.removed.begin() + before, c))
+      if (d.squaredNorm() < r2 && l.fragments.mass[l.fragments.label[c]] <= passes_kg &&
+          !std::binary_search(l.removed.begin(), l.removed.begin() + before, c)) {
         l.removed.push_back(c);
+        l.aspirated_mass_kg += l.cells.mass[c];
+      }
     }
     st.aspirated = static_cast<uint32_t>(l.removed.size()) - before;
     l.cells_aspirated += st.aspirated;
   }
+  if (fluidics && tools.phaco && tools.phaco->power > 0 && tools.probe_tip)
+    feed_held(l, *tools.probe_tip, tools.phaco->power, dt_s);
   remove_lens_cells(l, l.removed, st);
-  if (tools.hook || tools.aspirator) l.awake = true;
+  if (fluidics && tools.probe_tip && tools.chopper_tip) crack(l, tools, st);
+  if (tools.hook || aspirator) l.awake = true;
   st.fragments = l.fragments.count;
+  if (fluidics) hold_at_port(l, tools, st, dt_s);
   if (!l.awake) return st;
   // 3. tools change velocities; 1. gravity and viscosity, then the move; 4. fragment contact
   if (tools.hook) lens_tools::drag_with_hook(cells, *tools.hook, l.settings.hook, dt_s);
-  if (tools.aspirator) lens_tools::aspirate(cells, *tools.aspirator, l.settings.aspirator, dt_s);
+  if (aspirator) lens_tools::aspirate(cells, *aspirator, l.settings.aspirator, dt_s);
   lens_tools::integrate(cells, l.settings.medium, dt_s);
+  if (fluidics && l.held_fragment < l.fragments.count && tools.probe_tip) {
+    const uint32_t f = l.held_fragment;
+    const std::span<const uint32_t> members(l.fragments.members.data() + l.fragments.offsets[f],
+                                            l.fragments.size_of(f));
+    lens_tools::draw_to_tip(cells, members, *tools.probe_tip, tools.probe_velocity, l.held_nearest,
+                            l.settings.fluid, dt_s);
+  }
   apply_contact(l, st, dt_s);
   // 5. constraints, 6. shape matching
   lens_tools::constrain(cells, l.settings.bounds, l.contact);
   match_shapes(l, st, dt_s);
+  // The rigid fit can set a cell back out of the bag (by over a millimetre when a crack's halves
+  // push apart against the wall). With fluidics (the drill that fails on a capsule breach) a cell
+  // the fit left further out than the lens at rest stands out of the bag (its shoulders, up to
+  // 0.33 mm with the equator fit, constraints.hpp) is brought back to that distance: fragments
+  // never leave through the wall, and the resting lens is not squeezed.
+  if (fluidics) leash_to_bag(l, kRestOverlapMm);
   return st;
 }
 

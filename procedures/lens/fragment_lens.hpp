@@ -19,6 +19,12 @@
 //      a constraint moved this step weigh a thousand times their mass in the fit (seed 002 §6.1:
 //      "the interacting cells are forced to assume a very big mass"), so the fragment settles
 //      against the constraint instead of being pulled back through it.
+// With `fluidics` (the nucleus_removal drill, issue 19) the probe's port occludes, builds vacuum
+// and holds a fragment (lens_tools/fluidics.hpp), a cell at the port is taken in only when
+// ultrasound is on or its fragment fits through the port, and the probe and the chopper crack a
+// fragment they push apart across a trench (lens_tools/crack.hpp, simplex break_link).
+// Mass is accounted: initial = alive + emulsified + aspirated + grooved (removed at the drill's
+// start), each summed from the removed cells' masses as they go.
 // Until a tool first touches the lens (a removal, a hook or aspirator contact) the lens is asleep:
 // nothing moves and nothing is computed (model no more than the scene needs).
 #include <array>
@@ -36,7 +42,9 @@
 #include "engine/core/rng.hpp"
 #include "systems/lens_tools/cell_dynamics.hpp"
 #include "systems/lens_tools/constraints.hpp"
+#include "systems/lens_tools/crack.hpp"
 #include "systems/lens_tools/erosion.hpp"
+#include "systems/lens_tools/fluidics.hpp"
 #include "systems/shape_match/shape_match.hpp"
 #include "systems/simplex/simplex_cells.hpp"
 #include "systems/simplex/simplex_fragments.hpp"
@@ -55,6 +63,9 @@ struct FragmentLensSettings {
   double nucleus_hardness = 0.5;     // 0..1, cortex cells get half of it
   double capture_mm = 0.3;  // cells this close to an aspirating port are aspirated (removed)
   double density_kg_mm3 = 1.07e-6;
+  bool fluidics = false;  // occlusion, vacuum, holding and cracking (the nucleus_removal drill)
+  lens_tools::FluidicsSettings fluid;
+  lens_tools::CrackSettings crack;
 };
 
 // The tools acting on the lens this step (absent = not in the scene or not acting).
@@ -62,6 +73,12 @@ struct LensTools {
   std::optional<lens_tools::PhacoTip> phaco;
   std::optional<lens_tools::Hook> hook;
   std::optional<lens_tools::Aspirator> aspirator;
+  // With fluidics: the probe's tip and velocity, whether its pedal aspirates (≥ 2), and the
+  // chopper's tip (cracking needs both tips).
+  std::optional<Vec3> probe_tip;
+  Vec3 probe_velocity = Vec3::Zero();  // mm/s
+  bool aspirating = false;
+  std::optional<Vec3> chopper_tip;
 };
 
 struct FragmentLensStats {
@@ -72,6 +89,13 @@ struct FragmentLensStats {
   uint32_t contact_particles = 0;
   uint64_t contact_pairs = 0;
   shape_match::LensPassStats match;
+  // With fluidics.
+  lens_tools::CrackPush push;  // the tips' push this step (force, engaged, crack)
+  uint32_t links_broken = 0;
+  bool occluded = false;
+  bool held = false;  // a fragment follows the tip
+  double vacuum_mmhg = 0;
+  double cover_fraction = 0;
 };
 
 struct FragmentLens {
@@ -97,6 +121,18 @@ struct FragmentLens {
   std::vector<uint32_t> removed;
   std::vector<simplex::Removal> removals;
   bool awake = false;
+  // Fluidics and cracking (with settings.fluidics).
+  double vacuum_mmhg = 0;
+  uint32_t held_fragment = kNoSimplex;  // this step's label of the held fragment
+  uint32_t held_cell = kNoSimplex;      // a cell of it: labels change as cells go
+  Vec3 held_nearest = Vec3::Zero();     // its cell nearest the port, mm
+  double feed_budget_mm3 = 0;           // ultrasound on the held fragment not yet spent
+  lens_tools::CrackState crack_state;
+  std::vector<std::pair<uint32_t, uint32_t>> crack_links;
+  std::vector<double> cover_scratch;
+  uint64_t cracks = 0, links_broken = 0;
+  // Mass accounting, kg: initial = alive + emulsified + aspirated + grooved.
+  double initial_mass_kg = 0, emulsified_mass_kg = 0, aspirated_mass_kg = 0, grooved_mass_kg = 0;
   // Totals.
   uint64_t steps = 0, cells_removed = 0, cells_aspirated = 0;
   double volume_removed_mm3 = 0;
@@ -110,6 +146,13 @@ FragmentLens make_fragment_lens(const TetMesh& mesh, const FragmentLensSettings&
 // wakes the lens. What erosion does each step; also for scripted cuts (tests, the perf harness).
 void remove_lens_cells(FragmentLens& lens, std::span<const uint32_t> cells,
                        FragmentLensStats& stats);
+
+// Breaks the given internal links (cell, face) and relabels the fragments; wakes the lens.
+// Returns the number of links broken.
+uint32_t crack_lens(FragmentLens& lens, std::span<const std::pair<uint32_t, uint32_t>> links);
+
+// Σ mass of the alive cells, kg (in cell order).
+double alive_mass_kg(const FragmentLens& lens);
 
 FragmentLensStats step_fragment_lens(FragmentLens& lens, const LensTools& tools,
                                      const CounterRng& rng, uint64_t frame, double dt_s);

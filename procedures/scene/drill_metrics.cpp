@@ -16,6 +16,7 @@
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/cornea_cutting.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
+#include "procedures/scene/nucleus_removal_metrics.hpp"
 #include "procedures/scene/scene.hpp"
 #include "procedures/scene/tool_ports.hpp"
 #include "systems/deform/spring_law.hpp"
@@ -77,8 +78,9 @@ struct DrillRecord {
   std::vector<double> t_s;
   std::vector<DrillEvent> events;
   size_t tear_events_seen = 0;
-  std::optional<Vec3> first_grasp;  // where forceps first closed (grasp.offset_mm)
-  std::optional<Vec3> puncture;     // the cystotome's tip when it first cut the capsule
+  std::optional<Vec3> first_grasp;              // where forceps first closed (grasp.offset_mm)
+  std::optional<Vec3> puncture;                 // the cystotome's tip when it first cut the capsule
+  std::optional<NucleusRemovalRecord> nucleus;  // the nucleus_removal drill's measures
 };
 
 Anatomy anatomy_of(const eye::EyeParams& p) {
@@ -449,32 +451,40 @@ SystemDesc drill_metrics_system(Scene& scene) {
     h.tearing.reserve(samples);
     r.hands.push_back(std::move(h));
   }
+  if (scene.scenario.drill == Drill::NucleusRemoval) r.nucleus = make_nucleus_removal_record(scene);
   // The t = 0 sample: the tools' poses the scene starts from.
   r.t_s.push_back(0.0);
   for (size_t i = 0; i < r.hands.size(); ++i) sample_hand(scene, r, static_cast<int>(i), 0.0, 0.0);
   scene.world.name_component<DrillRecord>("metrics", AccessKind::Global);
   if (!scene.bodies.empty()) scene.world.add(scene.bodies.front(), std::move(r));
-  return {.name = "drill_metrics",
-          .phase = Phase::Metrics,
-          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.springs",
-                    "capsule.settings", "capsule.cutting", "lens.tets", "tools.ports"},
-          .writes = {"metrics"},
-          .after = {},
-          .run = [&scene](const FrameContext& ctx) {
-            DrillRecord* rec = record_of(scene);
-            if (!rec) return;
-            const double t = ctx.time_s + ctx.dt_s;  // the poses are those at the frame's end
-            rec->t_s.push_back(t);
-            for (size_t i = 0; i < rec->hands.size(); ++i)
-              sample_hand(scene, *rec, static_cast<int>(i), t, ctx.dt_s);
-            sample_tear(scene, *rec, t);
-            // The tool pressing its corneal port beyond the threshold (tool_ports.hpp; ports on
-            // only).
-            for (size_t i = 0; i < rec->hands.size(); ++i) {
-              if (double f = 0; port_stress_began(scene, i, f))
-                push_event(*rec, t, "port_stress", static_cast<int>(i), "force_mN", f);
-            }
-          }};
+  return {
+      .name = "drill_metrics",
+      .phase = Phase::Metrics,
+      .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.springs",
+                "capsule.settings", "capsule.cutting", "lens.tets", "lens.cells", "tools.ports"},
+      .writes = {"metrics"},
+      .after = {},
+      .run = [&scene](const FrameContext& ctx) {
+        DrillRecord* rec = record_of(scene);
+        if (!rec) return;
+        const double t = ctx.time_s + ctx.dt_s;  // the poses are those at the frame's end
+        rec->t_s.push_back(t);
+        for (size_t i = 0; i < rec->hands.size(); ++i)
+          sample_hand(scene, *rec, static_cast<int>(i), t, ctx.dt_s);
+        sample_tear(scene, *rec, t);
+        if (rec->nucleus) {
+          const uint32_t ruptured = sample_nucleus_removal(scene, *rec->nucleus, ctx.dt_s);
+          for (size_t i = 0; i < rec->hands.size(); ++i)
+            if (ruptured & (1u << i))
+              push_event(*rec, t, "posterior_capsule_rupture", static_cast<int>(i));
+        }
+        // The tool pressing its corneal port beyond the threshold (tool_ports.hpp; ports on
+        // only).
+        for (size_t i = 0; i < rec->hands.size(); ++i) {
+          if (double f = 0; port_stress_began(scene, i, f))
+            push_event(*rec, t, "port_stress", static_cast<int>(i), "force_mN", f);
+        }
+      }};
 }
 
 size_t drill_event_count(Scene& scene) {
@@ -514,6 +524,13 @@ DrillReport drill_report(Scene& scene) {
     case Drill::PhacoSculpting:
       sculpting_metrics(scene, *r, out);
       break;
+    case Drill::NucleusRemoval: {
+      uint64_t iris = 0;
+      for (const HandRecord& h : r->hands) iris += h.iris_contacts;
+      out.metrics["iris_contacts"] = iris;
+      if (r->nucleus) nucleus_removal_metrics(scene, *r->nucleus, out.metrics);
+      break;
+    }
     case Drill::CornealIncision: {
       uint64_t iris = 0;
       for (const HandRecord& h : r->hands) iris += h.iris_contacts;

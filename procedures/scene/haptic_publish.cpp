@@ -219,7 +219,8 @@ double haptic_tip_radius_mm(const Scene& scene, uint8_t tool_kind) {
     case ToolKind::Forceps:
     case ToolKind::Keratome:
     case ToolKind::Hook:
-      return 0.1;  // jaw tips, blade point, hook end
+    case ToolKind::Chopper:
+      return 0.1;  // jaw tips, blade point, hook or chopper end
   }
   return 0.1;
 }

@@ -27,6 +27,10 @@ const std::vector<MethodSetting>& method_settings() {
   return table;
 }
 
+std::string_view default_lens_model(Drill drill) {
+  return drill == Drill::NucleusRemoval ? "fragments" : "tets";
+}
+
 const MethodSetting* find_method_setting(std::string_view key) {
   for (const MethodSetting& m : method_settings())
     if (m.key == key) return &m;
@@ -70,7 +74,13 @@ std::string method_value(const Scenario& scenario, std::string_view key,
 void check_method_values(const Scenario& s, const DrillFile& drill) {
   for (const auto& [key, value] : s.methods)
     if (const MethodSetting* m = find_method_setting(key)) check_value(s, *m, value);
-  if (method_value(s, "lens.model", "tets") == "fragments") {
+  const std::string lens = method_value(s, "lens.model", default_lens_model(s.drill));
+  if (s.drill == Drill::NucleusRemoval && lens != "fragments")
+    refuse(s, "lens.model",
+           "the nucleus_removal drill cracks and removes fragments: it runs lens.model fragments, "
+           "got '" +
+               lens + "'");
+  if (lens == "fragments") {
     for (const char* key : {"lens.broadphase", "lens.narrowphase"})
       if (s.methods.count(key))
         refuse(s, key, "applies to lens.model tets (tetrahedral sculpting), not fragments");

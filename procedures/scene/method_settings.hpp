@@ -16,6 +16,10 @@ struct MethodSetting {
   std::vector<std::string_view> choices;  // empty: a number in (0, 1) (capsule.cg_tolerance)
 };
 
+// The lens model a drill runs unless its scenario says: "fragments" for nucleus_removal (seed 002's
+// fragmenting lens; the drill cannot run on the rigid tets), "tets" for the others.
+std::string_view default_lens_model(Drill drill);
+
 // The table, in the order docs/methods list them.
 const std::vector<MethodSetting>& method_settings();
 // The setting called `key`, or nullptr.

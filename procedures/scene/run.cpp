@@ -107,6 +107,8 @@ nlohmann::json to_json(const RunReport& r) {
   j["score_terms"] = r.score_terms;
   j["physics"] = r.physics;
   j["state_hash"] = r.state_hash;
+  // A drill that failed (nucleus_removal: a posterior capsule rupture) says so at the top.
+  j["failed"] = r.metrics.value("drill_failed", 0.0) > 0;
   return j;
 }
 
@@ -195,6 +197,7 @@ std::string summary_text(const RunReport& r) {
   if (r.metrics.contains("score")) {
     std::snprintf(line, sizeof line, "\nscore %.1f / 100", r.metrics["score"].get<double>());
     out += line;
+    if (r.metrics.value("drill_failed", 0.0) > 0) out += "   FAILED (posterior capsule rupture)";
     for (const auto& t : r.score_terms) {
       const std::string value = t["value"].is_number() ? t["value"].dump() : std::string("-");
       std::snprintf(line, sizeof line, "\n  %-28s %-12s %5.1f / %4.1f",

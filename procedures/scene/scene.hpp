@@ -7,6 +7,7 @@
 //   corneal_incision: cornea, iris, globe              (no lens at all)
 //   capsulorhexis:    cornea, capsule, iris, lens_surface
 //   phaco_sculpting:  cornea, capsule, iris, lens (tetrahedra)
+//   nucleus_removal:  cornea, capsule, iris, lens (simplex cells, grooved; lens_fragments.hpp)
 #include <cstdint>
 #include <filesystem>
 #include <functional>

@@ -28,3 +28,10 @@ incision "$out/corneal_incision_novice_steep.json" --angle 60 --name "corneal in
   --description "The expert's pass at 60 degrees below the corneal surface: the same site and width, but the tunnel is under 1 mm (a leaking wound)."
 incision "$out/corneal_incision_novice_site.json" --limbus 1.6 --name "corneal incision novice: too far inside the limbus" \
   --description "The expert's pass started 1.6 mm inside the limbus: a good tunnel, but in the clear cornea away from the limbus."
+nucleus() { python3 "$here/nucleus_removal.py" "$@"; }
+nucleus "$out/nucleus_removal_expert.json" --name "nucleus removal expert" \
+  --description "Three cracks with the probe and the chopper pushing apart in the grooved cross (two halves, then each half into quadrants); each quadrant occluded with aspiration while sweeping to the centre, held and emulsified there; what is left emulsified at the bottom of the bag."
+nucleus "$out/nucleus_removal_novice_rupture.json" --dip --name "nucleus removal novice: posterior capsule rupture" \
+  --description "The expert's hands, but after the second quadrant the probe dips through the posterior pole of the bag: a posterior capsule rupture, which fails the drill."
+nucleus "$out/nucleus_removal_novice_wasteful.json" --wasteful --name "nucleus removal novice: wasteful ultrasound" \
+  --description "The expert's hands, but with ultrasound (pedal 3) instead of aspiration while occluding, and two more seconds of ultrasound in the empty bag after every quadrant: far more cumulative dissipated energy."

@@ -1,6 +1,7 @@
 #include "systems/simplex/simplex_cells.hpp"
 
 #include <algorithm>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -147,6 +148,22 @@ uint32_t connect_shared_faces(const std::vector<std::array<uint32_t, 4>>& tets,
   return over_shared;
 }
 
+// Boundary links of faces that just became external (a removal's or a crack's): each finds its
+// partner on each edge through the solid, and the partner links back.
+void link_new_faces(SimplexCells& cells, std::span<const uint32_t> new_faces) {
+  const TopologyView v = view_of(cells);
+  for (const uint32_t f : new_faces) {
+    auto& own = cells.boundary_link[simplex_face_cell(f)];
+    for (uint32_t j = 0; j < 3; ++j) {
+      uint32_t ps = 0;
+      const uint32_t partner = walk(v, f, j, &ps, 4096);
+      own[3 * simplex_face_local(f) + j] = partner;
+      if (partner != kNoSimplex)
+        cells.boundary_link[simplex_face_cell(partner)][3 * simplex_face_local(partner) + ps] = f;
+    }
+  }
+}
+
 }  // namespace
 
 SimplexCells build_cells(const TetMesh& mesh, double density_kg_mm3) {
@@ -233,20 +250,20 @@ Removal remove_cell(SimplexCells& cells, uint32_t cell) {
   r.kind = static_cast<RemovalCase>(external);
   r.alive_neighbours = static_cast<uint8_t>(new_count);
   r.may_split = new_count >= 2;
-  // Boundary links: every new external face finds its partner on each edge through the solid.
-  const TopologyView v = view_of(cells);
-  for (uint32_t i = 0; i < new_count; ++i) {
-    const uint32_t f = new_faces[i];
-    auto& own = cells.boundary_link[simplex_face_cell(f)];
-    for (uint32_t j = 0; j < 3; ++j) {
-      uint32_t ps = 0;
-      const uint32_t partner = walk(v, f, j, &ps, 4096);
-      own[3 * simplex_face_local(f) + j] = partner;
-      if (partner != kNoSimplex)
-        cells.boundary_link[simplex_face_cell(partner)][3 * simplex_face_local(partner) + ps] = f;
-    }
-  }
+  link_new_faces(cells, std::span<const uint32_t>(new_faces.data(), new_count));
   return r;
+}
+
+bool break_link(SimplexCells& cells, uint32_t cell, uint32_t face) {
+  if (cell >= cells.size() || face > 3 || !cells.alive[cell]) return false;
+  const uint32_t n = cells.neighbour[cell][face];
+  if (n == kNoSimplex) return false;
+  const uint32_t f = cells.neighbour_face[cell][face];
+  cells.neighbour[cell][face] = kNoSimplex;
+  cells.neighbour[n][f] = kNoSimplex;
+  const std::array<uint32_t, 2> new_faces{simplex_face_id(cell, face), simplex_face_id(n, f)};
+  link_new_faces(cells, new_faces);
+  return true;
 }
 
 uint32_t count_external_faces(const SimplexCells& cells) {

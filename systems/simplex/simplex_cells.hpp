@@ -73,6 +73,14 @@ struct Removal {
 // allocate or throw.
 Removal remove_cell(SimplexCells& cells, uint32_t cell);
 
+// A crack (issue 19, the chopper): the internal link between `cell` and its neighbour across
+// `face` is broken, both faces become external and take their boundary links by the walk above,
+// exactly as a removal's new faces do; the cells stay. Returns false when there was no link.
+// Breaking links only ever splits, so fragments must be relabelled after (label_fragments_*).
+// check_boundary rebuilds from the tets and does not know of cracks: it reports a cracked lens's
+// broken links as neighbour mismatches. Does not allocate or throw.
+bool break_link(SimplexCells& cells, uint32_t cell, uint32_t face);
+
 // Partner of external face `face_id` across its edge slot `slot` by the walk through the solid;
 // returns the partner face id and writes its edge slot, or kNoSimplex if the walk exceeds
 // max_steps (a broken structure).

@@ -45,7 +45,8 @@ DrillFile parse(const json& j) {
 TEST(DrillFile, TheShippedDrillsLoadAndNameTheirDrills) {
   for (const auto& [name, drill] : {std::pair{"corneal_incision", Drill::CornealIncision},
                                     std::pair{"capsulorhexis", Drill::Capsulorhexis},
-                                    std::pair{"phaco_sculpting", Drill::PhacoSculpting}}) {
+                                    std::pair{"phaco_sculpting", Drill::PhacoSculpting},
+                                    std::pair{"nucleus_removal", Drill::NucleusRemoval}}) {
     const DrillFile d = load_drill_file(kDrillDir / (std::string(name) + ".json"));
     EXPECT_EQ(d.drill, drill) << name;
     double points = 0;
@@ -204,7 +205,8 @@ TEST(DrillFile, PortsModeIsOptionalAndChecked) {
   EXPECT_NE(e0.find("d.json: ports: mode 'measure' needs guidance.incision_site"),
             std::string::npos)
       << e0;
-  for (const char* name : {"corneal_incision", "capsulorhexis", "phaco_sculpting"}) {
+  for (const char* name :
+       {"corneal_incision", "capsulorhexis", "phaco_sculpting", "nucleus_removal"}) {
     EXPECT_EQ(load_drill_file(kDrillDir / (std::string(name) + ".json")).ports, "measure") << name;
   }
   json bad = valid_drill();

@@ -172,14 +172,18 @@ TEST(Scenario, RoundTripOfExampleFiles) {
 }
 
 TEST(Scenario, NamesRoundTrip) {
-  for (Drill d : {Drill::CornealIncision, Drill::Capsulorhexis, Drill::PhacoSculpting}) {
+  for (Drill d : {Drill::CornealIncision, Drill::Capsulorhexis, Drill::PhacoSculpting,
+                  Drill::NucleusRemoval}) {
     EXPECT_EQ(parse_drill(to_string(d)), d);
   }
-  for (ToolKind k : {ToolKind::Forceps, ToolKind::Keratome, ToolKind::Cystotome,
-                     ToolKind::PhacoProbe, ToolKind::Hook, ToolKind::Aspirator}) {
+  for (ToolKind k :
+       {ToolKind::Forceps, ToolKind::Keratome, ToolKind::Cystotome, ToolKind::PhacoProbe,
+        ToolKind::Hook, ToolKind::Aspirator, ToolKind::Chopper}) {
     EXPECT_EQ(parse_tool(to_string(k)), k);
   }
   EXPECT_EQ(to_string(ToolKind::PhacoProbe), "phaco_probe");
+  EXPECT_EQ(to_string(ToolKind::Chopper), "chopper");
+  EXPECT_EQ(to_string(Drill::NucleusRemoval), "nucleus_removal");
   EXPECT_EQ(parse_hand("left"), Hand::Left);
   EXPECT_FALSE(parse_drill("capsulotomy").has_value());
   EXPECT_FALSE(parse_tool("Forceps").has_value());

@@ -62,6 +62,9 @@ TEST_P(DrillScenario, MissesExactlyTheTargetsItsScriptBreaks) {
   for (const auto& e : r.events) kinds.insert(e.value("kind", ""));
   for (const auto& k : c.events_needed)
     EXPECT_TRUE(kinds.count(k)) << "event '" << k << "' missing";
+  // A rupture fails the drill, and only a rupture.
+  EXPECT_EQ(r.metrics.value("drill_failed", 0.0) > 0,
+            c.missed.count("posterior_capsule.rupture") > 0);
   if (c.missed.empty()) {
     EXPECT_DOUBLE_EQ(r.metrics["score"].get<double>(), 100.0) << "the expert loses no points";
   } else {
@@ -99,10 +102,12 @@ TEST(DrillDifficulty, TheExpertsHandsOnAHardEyeGetARunoutWarning) {
 TEST(DrillPivot, TheScriptedShaftsPassThroughTheirPortCentres) {
   const eye::EyeParams params = eye::default_eye_params();
   const eye::EyeGeometry g = eye::eye_geometry(params);
-  for (const char* file : {"capsulorhexis_expert.json", "capsulorhexis_novice_off_centre.json",
-                           "capsulorhexis_novice_runout.json", "capsulorhexis_novice_small.json",
-                           "phaco_sculpting_expert.json", "phaco_sculpting_novice_shallow.json",
-                           "phaco_sculpting_novice_narrow.json"}) {
+  for (const char* file :
+       {"capsulorhexis_expert.json", "capsulorhexis_novice_off_centre.json",
+        "capsulorhexis_novice_runout.json", "capsulorhexis_novice_small.json",
+        "phaco_sculpting_expert.json", "phaco_sculpting_novice_shallow.json",
+        "phaco_sculpting_novice_narrow.json", "nucleus_removal_expert.json",
+        "nucleus_removal_novice_rupture.json", "nucleus_removal_novice_wasteful.json"}) {
     const Scenario s = test::repo_scenario(file);
     const DrillFile drill = load_drill_for(s);
     ASSERT_TRUE(drill.guidance.incision_site && drill.guidance.side_port) << file;
@@ -158,7 +163,15 @@ INSTANTIATE_TEST_SUITE_P(
         DrillCase{"corneal_incision_novice_steep.json",
                   {"incision.entry_angle_deg", "incision.tunnel_length_mm"},
                   {}},
-        DrillCase{"corneal_incision_novice_site.json", {"incision.limbus_distance_mm"}, {}}),
+        DrillCase{"corneal_incision_novice_site.json", {"incision.limbus_distance_mm"}, {}},
+        // Nucleus removal (issue 19, scripts/scenarios/nucleus_removal.py): three cracks, then
+        // each quadrant held and emulsified. The dip goes through the posterior pole (a rupture,
+        // which fails the drill); the wasteful hands use ultrasound where aspiration does.
+        DrillCase{"nucleus_removal_expert.json", {}, {}},
+        DrillCase{"nucleus_removal_novice_rupture.json",
+                  {"posterior_capsule.min_distance_mm", "posterior_capsule.rupture"},
+                  {"posterior_capsule_rupture"}},
+        DrillCase{"nucleus_removal_novice_wasteful.json", {"cde_pct_s"}, {}}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));

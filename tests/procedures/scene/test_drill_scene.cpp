@@ -5,8 +5,10 @@
 
 #include <string>
 
+#include "components/tets.hpp"
 #include "engine/core/error.hpp"
 #include "procedures/eye/difficulty.hpp"
+#include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/lens_sculpting.hpp"
 #include "tests/support/expect_invalid.hpp"
 #include "tests/support/scene_run.hpp"
@@ -89,6 +91,35 @@ TEST(DrillScene, RefusesWhatTheDrillDoesNotAllow) {
   EXPECT_NE(e.find("is a 'phaco_sculpting' drill; the scenario is 'capsulorhexis'"),
             std::string::npos)
       << e;
+}
+
+}  // namespace
+}  // namespace phaco
+
+namespace phaco {
+namespace {
+
+// The nucleus_removal drill (issue 19) runs the fragmenting lens only, gives the left hand the
+// chopper, and starts from the grooved nucleus (cells removed before the first frame, the lens
+// body's tets with them).
+TEST(DrillScene, NucleusRemovalRefusesTheTetLensAndStartsGrooved) {
+  Scenario s = scenario(Drill::NucleusRemoval, ToolKind::PhacoProbe);
+  s.hands.insert(s.hands.begin(),
+                 {Hand::Left, ToolKind::Chopper, {TrackSample{0.0, Vec3(-1, 0, 3.5)}}});
+  const auto scene = build(s);
+  const Entity lens = *scene->body(BodyPart::Lens);
+  const LensFragments& lf = scene->world.at<LensFragments>(lens);
+  EXPECT_TRUE(lf.nucleus_removal);
+  EXPECT_GT(lf.grooved_volume_mm3, 10.0);
+  EXPECT_EQ(scene->world.at<Tets>(lens).slots.live_count(), lf.lens.cells.alive_count);
+  Scenario tets = s;
+  tets.methods["lens.model"] = "tets";
+  EXPECT_NE(error_of(tets).find("test.json: methods[\"lens.model\"]: the nucleus_removal drill"),
+            std::string::npos)
+      << error_of(tets);
+  Scenario wrong = s;
+  wrong.hands[0].tool = ToolKind::Hook;
+  EXPECT_NE(error_of(wrong).find("hands.left.tool"), std::string::npos) << error_of(wrong);
 }
 
 }  // namespace

@@ -59,13 +59,15 @@ TEST_P(SceneAccess, SystemsTouchOnlyWhatTheyDeclare) {
 }
 
 // The capsulorhexis expert's 11 s hold every cut, tear, grasp and release; the sculpting runs
-// cover both trenches' first passes and the turn; the incision the whole keratome stroke.
-INSTANTIATE_TEST_SUITE_P(Drills, SceneAccess,
-                         ::testing::Values(AccessCase{"capsulorhexis_expert.json", nullptr, 11.0},
-                                           AccessCase{"corneal_incision_expert.json", nullptr, 3.0},
-                                           AccessCase{"phaco_sculpting_expert.json", nullptr, 30.0},
-                                           AccessCase{"phaco_sculpting_demo.json", "fragments",
-                                                      6.0}));
+// cover both trenches' first passes and the turn; the incision the whole keratome stroke; the
+// nucleus removal its first crack and the first quadrant's hold.
+INSTANTIATE_TEST_SUITE_P(
+    Drills, SceneAccess,
+    ::testing::Values(AccessCase{"capsulorhexis_expert.json", nullptr, 11.0},
+                      AccessCase{"corneal_incision_expert.json", nullptr, 3.0},
+                      AccessCase{"phaco_sculpting_expert.json", nullptr, 30.0},
+                      AccessCase{"phaco_sculpting_demo.json", "fragments", 6.0},
+                      AccessCase{"nucleus_removal_expert.json", nullptr, 13.0}));
 
 }  // namespace
 }  // namespace phaco

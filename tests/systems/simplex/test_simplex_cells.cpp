@@ -9,6 +9,7 @@
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/eye/resolution.hpp"
 #include "systems/simplex/simplex_cells.hpp"
+#include "systems/simplex/simplex_fragments.hpp"
 #include "tests/systems/simplex/simplex_meshes.hpp"
 
 namespace phaco::simplex {
@@ -236,6 +237,60 @@ TEST(SimplexCells, BuildFlipsNegativeTetsAndRejectsAFaceSharedThrice) {
   bad.vertices.push_back(Vec3(1, 1, 0.5));
   bad.tets.push_back({0, 1, 2, 5});
   EXPECT_THROW(build_cells(bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace phaco::simplex
+
+namespace phaco::simplex {
+namespace {
+
+// A crack (break_link) along the plane x = 2 of a 4×4×4 Kuhn grid gives exactly the cells built
+// from the grid cut there (the plane's vertices duplicated for the tets beyond it): the same
+// neighbours and the same boundary links, face for face; and two fragments.
+TEST(SimplexCrack, BreakingTheLinksAcrossAPlaneEqualsBuildingTheTwoHalves) {
+  const TetMesh grid = testing::kuhn_grid(4);
+  auto beyond = [&](const std::array<uint32_t, 4>& t) {
+    double x = 0;
+    for (uint32_t v : t) x += grid.vertices[v].x();
+    return x / 4 > 2.0;
+  };
+  TetMesh halves = grid;
+  std::vector<uint32_t> twin(grid.vertices.size(), kNoSimplex);
+  for (auto& t : halves.tets) {
+    if (!beyond(t)) continue;
+    for (uint32_t& v : t) {
+      if (grid.vertices[v].x() != 2.0) continue;
+      if (twin[v] == kNoSimplex) {
+        twin[v] = static_cast<uint32_t>(halves.vertices.size());
+        halves.vertices.push_back(grid.vertices[v]);
+      }
+      v = twin[v];
+    }
+  }
+  const SimplexCells reference = build_cells(halves);
+  SimplexCells cracked = build_cells(grid);
+  const uint32_t faces_before = count_external_faces(cracked);
+  uint32_t broken = 0;
+  std::pair<uint32_t, uint32_t> first{kNoSimplex, 0};
+  for (uint32_t c = 0; c < cracked.size(); ++c) {
+    if (beyond(grid.tets[c])) continue;
+    for (uint32_t k = 0; k < 4; ++k) {
+      const uint32_t d = cracked.neighbour[c][k];
+      if (d == kNoSimplex || !beyond(grid.tets[d])) continue;
+      if (first.first == kNoSimplex) first = {c, k};
+      broken += break_link(cracked, c, k);
+    }
+  }
+  EXPECT_EQ(broken, 2u * 4u * 4u) << "two triangles per unit square of the plane";
+  EXPECT_FALSE(break_link(cracked, first.first, first.second)) << "a link breaks once";
+  EXPECT_EQ(count_external_faces(cracked), faces_before + 2 * broken);
+  EXPECT_EQ(cracked.neighbour, reference.neighbour);
+  EXPECT_EQ(cracked.boundary_link, reference.boundary_link);
+  Fragments f;
+  FragmentScratch scratch;
+  label_fragments_painting(cracked, f, scratch);
+  EXPECT_EQ(f.count, 2u);
 }
 
 }  // namespace

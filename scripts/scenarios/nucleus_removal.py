@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""Writes a scripted nucleus removal (issue 19): crack the grooved nucleus into quadrants with the
+phaco probe (right hand) and the chopper (left hand), then occlude, hold and emulsify each quadrant.
+
+usage: nucleus_removal.py OUT.json [--dip] [--wasteful] [--name N] [--description D]
+
+The drill starts with the nucleus grooved by a cross (data/drills/nucleus_removal.json,
+guidance.trench_cross: one trench along x, one along y, 1.35 mm wide, 80 % deep). The expert:
+  1. both tips into the x trench at x = -1.2, on its walls, pushed apart across it: the nucleus
+     cracks into two halves along y = 0;
+  2. the same in the y trench at y = +1.2 and at y = -1.2: four quadrants;
+  3. for each quadrant: the probe into its inner corner with aspiration (pedal 2) until the port
+     occludes and the vacuum holds the quadrant, then ultrasound (pedal 3) while the vacuum feeds it
+     into the tip; lift.
+--dip      (novice) after the second quadrant the probe dips through the posterior capsule at the
+           centre: a rupture.
+--wasteful (novice) ultrasound (pedal 3) instead of aspiration while occluding, and on for two
+           extra seconds in the empty bag after every quadrant: far more CDE.
+Each tool pivots in its corneal port (scripts/scenarios/ports.py): the probe in the main incision
+(3 o'clock), the chopper in the side port (11 o'clock).
+"""
+import argparse, json, math, re
+import ports
+ap = argparse.ArgumentParser()
+ap.add_argument("out")
+ap.add_argument("--dip", action="store_true")
+ap.add_argument("--wasteful", action="store_true")
+ap.add_argument("--quadrant-s", type=float, default=10.0)
+ap.add_argument("--cleanup-s", type=float, default=6.0)
+ap.add_argument("--level", type=int, default=1)
+ap.add_argument("--name", default="nucleus removal expert")
+ap.add_argument("--description", default="Crack the grooved nucleus into quadrants with the probe and the chopper pushing apart in the trenches, then occlude, hold and emulsify each quadrant.")
+args = ap.parse_args()
+
+P = ports.default_ports("nucleus_removal")
+main, main_axis = P["main"]
+side, side_axis = P["side"]
+rest_p = [main[i] + 0.25 * main_axis[i] for i in range(3)]
+rest_c = [side[i] + 0.25 * side_axis[i] for i in range(3)]
+
+def inward(centre, r, z):
+    """A point on the port's azimuth at radius r and height z: in the pupil, above the iris."""
+    rho = math.hypot(centre[0], centre[1])
+    return [centre[0] * r / rho, centre[1] * r / rho, z]
+
+probe, chop = [], []
+t = 0.0
+def both(dt, p, pedal, c):
+    global t
+    t += dt
+    probe.append({"t": round(t, 3), "pos": [round(v, 4) for v in p], "quat": [1, 0, 0, 0], "pedal": pedal})
+    chop.append({"t": round(t, 3), "pos": [round(v, 4) for v in c], "quat": [1, 0, 0, 0]})
+probe.append({"t": 0.0, "pos": [round(v, 4) for v in rest_p], "quat": [1, 0, 0, 0], "pedal": 0})
+chop.append({"t": 0.0, "pos": [round(v, 4) for v in rest_c], "quat": [1, 0, 0, 0]})
+
+Z_CRACK = -0.3   # 0.96 mm above the trench floor at the centre (-1.26)
+Z_ABOVE = 2.0    # over the lens, under the iris plane's height of the port
+park_p = inward(main, 3.0, Z_ABOVE)
+park_c = inward(side, 3.0, Z_ABOVE)
+both(1.0, park_p, 1, park_c)
+
+def crack(p_at, c_at, spread):
+    """Both tips down onto opposite walls of a trench, pushed apart by `spread` each, lifted."""
+    above_p, above_c = p_at[:2] + [Z_ABOVE], c_at[:2] + [Z_ABOVE]
+    both(0.8, above_p, 1, above_c)
+    both(0.6, p_at[:2] + [Z_CRACK], 1, c_at[:2] + [Z_CRACK])
+    d = [p_at[i] - c_at[i] for i in range(2)]
+    n = math.hypot(*d); d = [v / n for v in d]
+    pa = [p_at[0] + spread * d[0], p_at[1] + spread * d[1], Z_CRACK]
+    ca = [c_at[0] - spread * d[0], c_at[1] - spread * d[1], Z_CRACK]
+    both(0.6, pa, 1, ca)
+    both(0.3, pa, 1, ca)
+    both(0.6, pa[:2] + [Z_ABOVE], 1, ca[:2] + [Z_ABOVE])
+
+# The walls of a 1.35 mm trench are at +-0.675: the tips start 0.4 off its middle.
+crack([-1.2, -0.4], [-1.2, 0.4], 0.2)   # along the x trench: two halves
+crack([0.4, 1.2], [-0.4, 1.2], 0.2)     # the +y half along the y trench
+crack([0.4, -1.2], [-0.4, -1.2], 0.2)   # the -y half
+
+chopper_park = [-1.0, 0.0, Z_ABOVE]
+occlude_pedal = 3 if args.wasteful else 2
+for k, (sx, sy) in enumerate(((1, 1), (1, -1), (-1, 1), (-1, -1))):
+    # Into the quadrant (pedal 1), then aspirating while sweeping toward the centre: the port
+    # occludes on the quadrant wherever it now lies, the vacuum holds it and it follows the tip
+    # to the middle of the bag, away from the capsule; there ultrasound emulsifies it as the
+    # vacuum feeds it in.
+    both(0.6, [sx * 1.6, sy * 1.6, 1.6], 1, chopper_park)
+    both(0.5, [sx * 1.6, sy * 1.6, -0.2], 1, chopper_park)
+    both(0.05, [sx * 1.6, sy * 1.6, -0.2], occlude_pedal, chopper_park)
+    both(1.2, [sx * 0.5, sy * 0.5, 0.0], occlude_pedal, chopper_park)
+    both(0.05, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)
+    both(args.quadrant_s, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)
+    if args.wasteful:
+        both(2.0, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)   # ultrasound in the empty bag
+    both(0.05, [sx * 0.5, sy * 0.5, 0.0], 1, chopper_park)
+    both(0.4, [sx * 1.0, sy * 1.0, 1.6], 1, chopper_park)
+    if args.dip and k == 1:
+        both(0.6, [0.0, 0.0, 0.0], 1, chopper_park)
+        both(0.6, [0.0, 0.0, -2.9], 1, chopper_park)   # through the posterior pole (z = -2.7)
+        both(0.6, [0.0, 0.0, 1.6], 1, chopper_park)
+# What is left rests at the bottom of the bag's bowl: occlude on it there and emulsify it.
+both(0.6, [0.3, 0.0, 1.0], 1, chopper_park)
+both(0.05, [0.3, 0.0, 1.0], occlude_pedal, chopper_park)
+both(1.0, [0.0, 0.0, -1.0], occlude_pedal, chopper_park)
+both(0.05, [0.0, 0.0, -1.0], 3, chopper_park)
+both(args.cleanup_s, [0.0, 0.0, -0.6], 3, chopper_park)
+both(0.05, [0.0, 0.0, -0.6], 1, chopper_park)
+both(0.8, park_p, 1, park_c)
+both(0.8, rest_p, 0, rest_c)
+
+inside = ports.inside_eye()
+probe = ports.pivot_track(probe, main, main_axis, inside)
+chop = ports.pivot_track(chop, side, side_axis, inside)
+sc = {
+  "name": args.name,
+  "description": args.description,
+  "drill": "nucleus_removal",
+  "eye": {"level": args.level},
+  "dt_s": 1/120,
+  "seed": 19,
+  "duration_s": round(t, 3),
+  "hands": {"left": {"tool": "chopper", "track": chop},
+            "right": {"tool": "phaco_probe", "track": probe}}
+}
+s = json.dumps(sc, indent=2)
+s = re.sub(r'\{\s+"t": ([^{}]*?)\s+\}', lambda m: '{ "t": ' + re.sub(r'\s+', ' ', m.group(1)) + ' }', s)
+s = re.sub(r'\[\s+([-\d.e, \s]+?)\s+\]', lambda m: '[' + re.sub(r'\s+', ' ', m.group(1)) + ']', s)
+open(args.out, 'w').write(s + "\n")
