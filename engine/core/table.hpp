@@ -7,6 +7,7 @@
 // valid during a frame; compaction (at a sync point only) closes the holes, keeps the order of
 // the live elements (so results stay deterministic) and returns the old→new remap that owners
 // apply to every index column that refers to this table.
+#include <cassert>
 #include <concepts>
 #include <cstdint>
 #include <span>
@@ -30,7 +31,10 @@ class SlotIndex {
   uint32_t size() const { return static_cast<uint32_t>(generation_.size()); }  // incl. tombstones
   uint32_t live_count() const { return size() - static_cast<uint32_t>(free_.size()); }
   bool alive(uint32_t i) const { return i < size() && alive_[i] != 0; }
-  uint32_t generation(uint32_t i) const { return generation_[i]; }
+  uint32_t generation(uint32_t i) const {
+    assert(i < size() && "slot index past the table");
+    return generation_[i];
+  }
   Handle handle(uint32_t i) const { return alive(i) ? Handle{i, generation_[i]} : Handle{}; }
   bool valid(Handle h) const { return alive(h.index) && generation_[h.index] == h.generation; }
   std::span<const uint8_t> alive_mask() const { return alive_; }
@@ -63,9 +67,20 @@ concept SoaTable = requires(T& t) {
   t.for_each_column([](auto&) {});
 };
 
+// Debug builds: every column of a table has one entry per slot (a column left behind by an
+// insertion would be read past its end, or silently shifted by the next compaction).
+template <SoaTable T>
+bool columns_in_step(T& table) {
+  bool ok = true;
+  const size_t n = table.slots.size();
+  table.for_each_column([&](auto& column) { ok = ok && column.size() == n; });
+  return ok;
+}
+
 // Moves the live entries of one column to their new places, in order, and shrinks it.
 template <class Col>
 void apply_remap(const Remap& remap, std::vector<Col>& column) {
+  assert(column.size() == remap.old_to_new.size() && "a column out of step with its table");
   for (uint32_t old = 0; old < remap.old_to_new.size() && old < column.size(); ++old) {
     const uint32_t to = remap.old_to_new[old];
     if (to != kInvalidIndex && to != old) column[to] = std::move(column[old]);
@@ -80,6 +95,7 @@ inline void remap_indices(const Remap& remap, std::span<uint32_t> indices) {
 
 template <SoaTable T>
 uint32_t table_add(T& table) {
+  assert(columns_in_step(table));
   bool appended = false;
   const uint32_t i = table.slots.acquire(&appended);
   table.for_each_column([&](auto& column) {
@@ -99,6 +115,7 @@ bool table_remove(T& table, uint32_t i) {
 
 template <SoaTable T>
 Remap table_compact(T& table) {
+  assert(columns_in_step(table));
   Remap remap = table.slots.compact();
   table.for_each_column([&](auto& column) { apply_remap(remap, column); });
   return remap;
@@ -109,6 +126,7 @@ template <SoaTable T>
 uint32_t table_append(T& table, uint32_t n) {
   const uint32_t first = table.slots.append(n);
   table.for_each_column([&](auto& column) { column.resize(column.size() + n); });
+  assert(columns_in_step(table));
   return first;
 }
 

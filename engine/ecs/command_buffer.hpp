@@ -7,6 +7,10 @@
 // the per-worker buffers are merged and stably sorted by key, so the result is the same for any
 // number of threads as long as keys are unique; equal keys keep worker order.
 // Recording may allocate (structural changes are rare events, not per-element work).
+//
+// Thread-safety (issue 22): a CommandBuffer is one worker's; its methods are not thread-safe.
+// CommandQueues::for_worker(w) may be called from every worker at once, each with its own w (the
+// `worker` of parallel_for); pending() and apply() only when no system runs (the sync point).
 #include <cstdint>
 #include <functional>
 #include <string>

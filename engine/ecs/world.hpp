@@ -5,6 +5,15 @@
 // live in flat SoA tables inside components, so per-entity lookups here are never on a hot path.
 // Component storage is one pool per type: entity index -> component, iterated in entity-index
 // order so that every walk over the world is deterministic.
+//
+// Thread-safety (issue 22; per method below where it differs):
+//   - structural calls (create, destroy, add, remove, name_component) change the pools: only with
+//     no system running, i.e. while the scene is built or from CommandQueues::apply at the frame's
+//     sync point;
+//   - lookups (alive, kind, name, find, get, at, has, each) may run from several systems at once,
+//     as the frame graph schedules them: they read the pools without changing them. What they
+//     return is shared by the systems that declared it; two systems writing one component never
+//     run together (the graph is built from SystemDesc reads/writes, checked in debug builds).
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -57,8 +66,10 @@ struct Pool final : PoolBase {
 
 class World {
  public:
+  // Not thread-safe: no system may run (see above).
   Entity create(EntityKind kind, std::string name);
   // Removes the entity and all its components; false if it was already gone (stale handle).
+  // Not thread-safe: no system may run.
   bool destroy(Entity e);
   bool alive(Entity e) const { return entities_.slots.valid(e); }
   EntityKind kind(Entity e) const { return entities_.kind[checked(e)]; }

@@ -16,6 +16,7 @@
 // data (a device sample) because it is copied in and out.
 #include <array>
 #include <atomic>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -66,6 +67,7 @@ class SpscRing {
       head_cache_ = head_.load(std::memory_order_acquire);
       if (tail == head_cache_) return false;
     }
+    assert(head_cache_ - tail <= Capacity && "the producer overran the consumer");
     out = slots_[tail & kMask];
     // Release: our read of the slot is done before the producer may overwrite it.
     tail_.store(tail + 1, std::memory_order_release);

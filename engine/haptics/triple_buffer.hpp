@@ -18,6 +18,7 @@
 // Reads/writes: only the slots and the three indices below. Allocation: the three slots, in the
 // constructor only.
 #include <atomic>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -46,6 +47,9 @@ class TripleBuffer {
     const uint8_t old =
         middle_.exchange(static_cast<uint8_t>(write_ | kFresh), std::memory_order_acq_rel);
     write_ = old & kIndexMask;
+    // The three indices are always a permutation of 0, 1, 2 (each side owns one slot); the
+    // producer may check its own against the consumer's only in a test, so here: in range.
+    assert(write_ < 3);
   }
 
   // Consumer: takes the newest slot if one was published since the last acquire. Returns true
@@ -58,7 +62,9 @@ class TripleBuffer {
     // slot back only after our reads of it are done. Only the consumer clears kFresh, so the
     // middle is still fresh here (the producer may have swapped in an even newer slot: fine).
     const uint8_t old = middle_.exchange(read_, std::memory_order_acq_rel);
+    assert((old & kFresh) && "only the consumer clears the fresh bit");
     read_ = old & kIndexMask;
+    assert(read_ < 3);
     return true;
   }
 

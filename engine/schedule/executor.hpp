@@ -47,6 +47,10 @@ struct ExecutorSettings {
   double dispatch_cost_ms = 0.05;
 };
 
+// Thread-safety (issue 22): an Executor is driven by one thread (the simulation's). run_frame is
+// not reentrant and must not overlap another call on the same executor; the systems it runs may
+// use parallel_for inside its task arena. The getters read what the last run_frame left: call
+// them from the driving thread between frames. Two executors on two threads are independent.
 class Executor {
  public:
   // threads >= 1 (std::invalid_argument otherwise). The graph must outlive the executor.
