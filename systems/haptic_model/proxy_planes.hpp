@@ -18,9 +18,9 @@ struct Plane {
   double cap = 0;      // mN
 };
 
-// Sphere contacts a tick keeps (the deepest): a 0.45 mm tip on a packing of 0.1–0.2 mm cells
-// meets a few dozen at most when pressed onto a surface.
-inline constexpr uint32_t kMaxSphereContacts = 32;
+// Sphere contacts a tick keeps (the deepest): a 0.45 mm tip pressed into a level-3 lens (cells of
+// ≈ 0.1 mm radius) meets up to about a hundred; with 32 the set changed as the tip slid.
+inline constexpr uint32_t kMaxSphereContacts = 128;
 inline constexpr uint32_t kMaxPlanes = kHapticMaxContacts + 1 + kMaxSphereContacts;
 using Planes = std::array<Plane, kMaxPlanes>;
 
