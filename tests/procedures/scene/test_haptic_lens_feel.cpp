@@ -15,18 +15,13 @@
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/haptic_model/haptic_model.hpp"
+#include "tests/support/capture_port.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
 namespace {
 
-class CapturePort final : public HapticPort {
- public:
-  bool newest_pose(Hand, ToolPose&) override { return false; }
-  HapticModel& model_slot() override { return slot; }
-  void publish_model() override {}
-  HapticModel slot;
-};
+using test::CapturePort;
 
 struct Feel {
   double max_mn = 0;                      // largest force

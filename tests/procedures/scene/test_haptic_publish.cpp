@@ -19,20 +19,13 @@
 #include "procedures/scene/lens_sculpting.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/haptic_model/haptic_model.hpp"
+#include "tests/support/capture_port.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
 namespace {
 
-// A haptic runtime stand-in: no device, keeps the last published model.
-class CapturePort final : public HapticPort {
- public:
-  bool newest_pose(Hand, ToolPose&) override { return false; }
-  HapticModel& model_slot() override { return slot; }
-  void publish_model() override { ++published, last_sequence = slot.sequence; }
-  HapticModel slot;
-  uint64_t published = 0, last_sequence = 0;
-};
+using test::CapturePort;
 
 std::unique_ptr<Scene> scene_at(const char* scenario, double t_s, CapturePort& port) {
   const Scenario s = test::repo_scenario(scenario);
