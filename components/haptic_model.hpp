@@ -10,11 +10,17 @@
 //   grasp     the node the forceps hold, if any: it follows the tool proxy, and the user feels
 //             the springs pulling it back (the flap's spring)
 //   lens      the lens's shape near the tool, for seed 003's F = −k_f·d (penetration depth)
+//   spheres   lens material near the tip as contact spheres (issue 19 item 5): the sculpted
+//             nucleus (surface tets, or simplex cells) and loose fragments, for any tool; under
+//             ultrasound the material's reaction is capped (the tip cuts through it)
+//   held      a fragment held at the tip by aspiration (components/held_fragment.hpp)
 //
-// Fixed capacity so that a copy into the triple buffer never allocates (≈ 31 KiB per tool).
+// Fixed capacity so that a copy into the triple buffer never allocates (≈ 36 KiB per tool).
 // Plain data only; systems/haptic_model computes the force, procedures/scene fills it.
 #include <array>
 #include <cstdint>
+
+#include "components/held_fragment.hpp"
 
 namespace phaco {
 
@@ -22,6 +28,7 @@ inline constexpr uint32_t kHapticTools = 2;           // one per hand
 inline constexpr uint32_t kHapticMaxNodes = 384;      // active set (≈ 121 for k = 5) + anchors
 inline constexpr uint32_t kHapticMaxSprings = 1536;   // ≈ 4 per node on the capsule's grids
 inline constexpr uint32_t kHapticMaxTriangles = 256;  // contact patch
+inline constexpr uint32_t kHapticMaxSpheres = 256;    // lens material near the tip
 inline constexpr uint16_t kHapticNoNode = 0xFFFF;
 
 // Free nodes move under their springs; anchored ones hold still (outside the active set, or on a
@@ -68,6 +75,22 @@ struct HapticTool {
   float lens_anterior_mm = 1.8f;   // half-thickness toward +z
   float lens_posterior_mm = 2.7f;  // half-thickness toward −z
   float lens_stiffness_mn_per_mm = 0;
+
+  // Lens material near the tip (issue 19 item 5), published by procedures/scene/
+  // haptic_lens_contacts for every tool: each sphere stands for one alive tet (lens.model tets)
+  // or simplex cell (lens.model fragments) with an exposed face, centred at its centroid with its
+  // equal-volume radius, nearest the tip first. Each pushes the tip sphere out along the line
+  // between centres with its own stiffness (the nucleus harder than the cortex). Rigid between
+  // publishes: the sculpting removes spheres, the fragments move them, one frame at a time.
+  uint32_t sphere_count = 0;
+  std::array<float, kHapticMaxSpheres> sphere_x{}, sphere_y{}, sphere_z{};  // centre, mm
+  std::array<float, kHapticMaxSpheres> sphere_r{};                          // radius, mm
+  std::array<float, kHapticMaxSpheres> sphere_k{};                          // mN/mm
+  // The probe under ultrasound (pedal 3) cuts: the material yields, its whole reaction on the tip
+  // is bounded by this force. 0: no bound (no ultrasound, or another tool).
+  float cut_force_mn = 0;
+
+  HeldFragment held;  // a fragment held at the tip, its load felt (held.held false: none)
 };
 
 struct HapticModel {

@@ -88,6 +88,7 @@ const std::vector<EyeParamRange>& eye_param_ranges() {
       {"haptic_model.contact_radius_mm", 0.05, 10},
       {"haptic_model.lens_stiffness_mn_mm", 0.1, 1e4},
       {"haptic_model.patch_stiffness_mn_mm", 0.1, 1e4},
+      {"haptic_model.cut_force_mn", 0.1, 1e3},  // the ultrasound probe's cut (haptic_lens_contacts)
       {"iris.z_mm", 0.5, 4},
       {"iris.pupil_diameter_mm", 1, 12},  // the iris's outer edge is checked with the geometry
       {"cornea.posterior_apex_z_mm", 2, 8},

@@ -11,6 +11,7 @@
 #include "engine/core/clock.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/haptic_lens_contacts.hpp"
 #include "procedures/scene/scene.hpp"
 
 namespace phaco {
@@ -27,6 +28,9 @@ void clear_tool(HapticTool& t) {
   t.grasp_limit_mn = 0;
   t.lens_present = false;
   t.damping_mn_s_per_mm = 0;
+  t.sphere_count = 0;
+  t.cut_force_mn = 0;
+  t.held = {};
 }
 
 // Every particle once, for a capsule integrated whole (no active set: no locality to keep).
@@ -231,6 +235,7 @@ HapticPublishSettings haptic_publish_settings(const Scene& scene) {
   s.contact_radius_mm = scene.params.get("haptic_model.contact_radius_mm");
   s.lens_stiffness_mn_mm = scene.params.get("haptic_model.lens_stiffness_mn_mm");
   s.patch_stiffness_mn_mm = scene.params.get("haptic_model.patch_stiffness_mn_mm");
+  s.lens = haptic_lens_settings(scene);
   return s;
 }
 
@@ -244,6 +249,7 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
   const auto capsule = scene.body(BodyPart::Capsule);
   const bool has_capsule_physics = capsule && scene.world.get<CapsuleSprings>(*capsule);
   const bool has_lens = scene.body(BodyPart::Lens) || scene.body(BodyPart::LensSurface);
+  const bool sculptable_lens = has_sculptable_lens(scene);
   if (has_capsule_physics) track_capsule_particles(scene, *capsule, settings, scratch);
   for (Entity e : scene.tools) {
     const Tool& tool = *scene.world.get<Tool>(e);
@@ -265,9 +271,11 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
       if (grasped != kInvalidIndex && cc && cc->flap.tip != kInvalidIndex)
         t.grasp_limit_mn = static_cast<float>(cc->tear.threshold_mn);
     }
-    // The probe sculpts the lens on purpose (phaco_sculpting): no lens-touch force for it there.
-    const bool sculpting_probe = tool.kind == ToolKind::PhacoProbe && scene.body(BodyPart::Lens);
-    if (has_lens && !sculpting_probe) {
+    // A lens the tools sculpt or break is felt as it is now, spheres of its material near the tip
+    // (issue 19 item 5); the analytic lens of seed 003 §E.5 only where it keeps its shape.
+    if (sculptable_lens) {
+      fill_lens_contacts(scene, e, settings.lens, scratch.lens, t);
+    } else if (has_lens) {
       t.lens_present = true;
       t.lens_centre_mm = {0.0f, 0.0f, 0.0f};
       t.lens_equator_radius_mm =
@@ -286,8 +294,9 @@ SystemDesc haptic_publish_system(Scene& scene) {
   auto scratch = std::make_shared<HapticPublishScratch>();
   return {.name = "publish_haptics",
           .phase = Phase::Publish,
-          .reads = {"tools.pose", "tools.grasp", "capsule.particles", "capsule.springs",
-                    "capsule.solver", "capsule.settings", "capsule.triangles", "capsule.cutting"},
+          .reads = {"tools.pose", "tools.grasp", "tools.held", "capsule.particles",
+                    "capsule.springs", "capsule.solver", "capsule.settings", "capsule.triangles",
+                    "capsule.cutting", "lens.sculpting", "lens.tets", "lens.cells"},
           .writes = {"haptics.model"},
           .run = [&scene, settings, scratch](const FrameContext&) {
             HapticModel& slot = scene.haptics->model_slot();

@@ -10,9 +10,10 @@
 //   springs  every capsule spring between two local nodes (Hooke; the scene's rest lengths, which
 //            carry the pretension, and stiffnesses)
 //   patch    capsule triangles whose three corners are local, nearest the tip first
-//   lens     the standard lens's two half-ellipsoids for seed 003 §E.5's F = −k_f·d; left out for
-//            the phaco probe in the sculpting scene, which goes into the lens on purpose (the
-//            resistance of the nucleus to the probe is not modelled)
+//   lens     the standard lens's two half-ellipsoids for seed 003 §E.5's F = −k_f·d, where the
+//            lens keeps its shape; a lens the tools sculpt or break (lens.model tets or fragments)
+//            is published instead as spheres of its material near each tip, with the tool's held
+//            fragment (procedures/scene/haptic_lens_contacts, issue 19 item 5)
 //
 // Cost: re-binning the active set (systems/point_bins), then per tool the bins within the contact
 // radius, a breadth-first walk of the ball and of its triangle fans, and a ≈ 62 KiB model write:
@@ -20,12 +21,13 @@
 // keep: the first frame's binning, a capsule without an active set, and, with capsule.cutting off,
 // the patch (no vertex-to-triangle index). Reads: tools.pose, tools.grasp, capsule.particles,
 // capsule.springs, capsule.solver (the active set), capsule.settings, capsule.triangles,
-// capsule.cutting. Writes: haptics.model.
+// capsule.cutting, tools.held, lens.sculpting, lens.tets, lens.cells. Writes: haptics.model.
 #include <cstdint>
 #include <vector>
 
 #include "components/haptic_model.hpp"
 #include "engine/schedule/system.hpp"
+#include "procedures/scene/haptic_lens_contacts.hpp"
 #include "systems/point_bins/point_bins.hpp"
 
 namespace phaco {
@@ -37,6 +39,7 @@ struct HapticPublishSettings {
   double contact_radius_mm = 1.0;     // a tool this near the capsule takes a local model of it
   double lens_stiffness_mn_mm = 100;  // seed 003 §E.5 k_f
   double patch_stiffness_mn_mm = 200;
+  HapticLensSettings lens;
 };
 
 // Scratch kept between frames so that publishing does not allocate once warm.
@@ -48,6 +51,7 @@ struct HapticPublishScratch {
   std::vector<std::pair<float, uint32_t>> near_triangles;  // squared distance to the tip, triangle
   std::vector<uint32_t> fan;                               // one node's triangles
   point_bins::PointBins bins;  // the capsule's particles, for the nearest
+  HapticLensScratch lens;
 };
 
 // The settings from the eye parameters' haptic_model section.

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "components/from_mesh.hpp"
+#include "components/held_fragment.hpp"
 #include "components/particles.hpp"
 #include "components/tets.hpp"
 #include "components/tool.hpp"
@@ -235,6 +236,7 @@ void name_base_components(World& world) {
   world.name_component<Tool>("kind", AccessKind::Constant);
   world.name_component<ToolTrack>("track");
   world.name_component<ToolState>("pose");
+  world.name_component<HeldFragment>("held");  // filled by the drill's aspiration
 }
 
 std::vector<SystemDesc> base_systems(Scene& scene) {

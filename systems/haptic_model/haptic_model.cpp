@@ -7,8 +7,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "systems/haptic_model/proxy_planes.hpp"
+
 namespace phaco::haptic_model {
 namespace {
+
+using detail::Plane;
+using detail::Planes;
 
 constexpr double kHalfPi = 1.57079632679489661923;
 constexpr int kArcSamples = 33;  // 32 intervals per quarter meridian
@@ -170,28 +175,29 @@ void gather_contacts(const HapticSlot& s, const HapticScratch& sc, const Vec3& q
     list[k].weight = list[k].weight * list[k].penetration_mm / denom;
 }
 
-struct Plane {
-  Vec3 normal, point;
-  double k;
-};
-
-// argmin ½k_c|P − D|² + Σ ½k_j·max(0, r − n_j·(P − p_j))²: a strongly convex, piecewise quadratic
-// energy. Newton on the piece the current P lies in (its 3×3 system solved exactly), with
-// backtracking on the energy: plain piece-hopping can cycle between the pieces of a stiff valley
-// (the proxy jumped tangentially there), the line search cannot. Warm-started from the last proxy;
-// ≤ 12 rounds (2–3 typical).
-double proxy_energy(const Vec3& p, const Vec3& d, double kc, double r,
-                    const std::array<Plane, kHapticMaxContacts + 1>& planes, uint32_t count) {
+// argmin ½k_c|P − D|² + Σ E_j(max(0, r − n_j·(P − p_j))), E_j the plane's energy (½k·pen², linear
+// past its cap: proxy_planes.hpp): a strongly convex, piecewise quadratic energy. Newton on the
+// piece the current P lies in (its 3×3 system solved exactly), with backtracking on the energy:
+// plain piece-hopping can cycle between the pieces of a stiff valley (the proxy jumped tangentially
+// there), the line search cannot. Warm-started from the last proxy; ≤ 12 rounds (2–3 typical).
+double proxy_energy(const Vec3& p, const Vec3& d, double kc, double r, const Planes& planes,
+                    uint32_t count) {
   double e = 0.5 * kc * (p - d).squaredNorm();
   for (uint32_t j = 0; j < count; ++j) {
-    const double pen = r - planes[j].normal.dot(p - planes[j].point);
-    if (pen > 0) e += 0.5 * planes[j].k * pen * pen;
+    const Plane& pl = planes[j];
+    const double pen = r - pl.normal.dot(p - pl.point);
+    if (!(pen > 0)) continue;
+    if (pl.cap > 0 && pl.k * pen > pl.cap) {
+      e += pl.cap * pen - 0.5 * pl.cap * pl.cap / pl.k;
+    } else {
+      e += 0.5 * pl.k * pen * pen;
+    }
   }
   return e;
 }
 
-Vec3 solve_proxy(const Vec3& d, const Vec3& start, double kc, double r,
-                 const std::array<Plane, kHapticMaxContacts + 1>& planes, uint32_t count) {
+Vec3 solve_proxy(const Vec3& d, const Vec3& start, double kc, double r, const Planes& planes,
+                 uint32_t count) {
   Vec3 p = finite(start) ? start : d;
   if (proxy_energy(d, d, kc, r, planes, count) < proxy_energy(p, d, kc, r, planes, count)) p = d;
   double e = proxy_energy(p, d, kc, r, planes, count);
@@ -200,7 +206,12 @@ Vec3 solve_proxy(const Vec3& d, const Vec3& start, double kc, double r,
     Vec3 b = kc * d;
     for (uint32_t j = 0; j < count; ++j) {
       const Plane& pl = planes[j];
-      if (r - pl.normal.dot(p - pl.point) <= 0) continue;
+      const double pen = r - pl.normal.dot(p - pl.point);
+      if (!(pen > 0)) continue;
+      if (pl.cap > 0 && pl.k * pen > pl.cap) {  // yielding: a constant push, no stiffness
+        b += pl.cap * pl.normal;
+        continue;
+      }
       a += pl.k * pl.normal * pl.normal.transpose();
       b += pl.k * pl.normal * (pl.normal.dot(pl.point) + r);
     }
@@ -446,11 +457,11 @@ void init_sides(HapticSlot& s, HapticScratch& sc) {
 void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& dev_vel,
                const HapticSettings& st, uint64_t& resets) {
   const HapticTool& m = s.model;
-  s.active = 0, s.penetration_mm = 0, s.lens_depth_mm = 0, s.iterations = 0;
+  s.active = 0, s.penetration_mm = 0, s.lens_depth_mm = 0, s.sphere_depth_mm = 0, s.iterations = 0;
   const double dt = st.dt_s;
   if (!m.present) {
     s.proxy_velocity = (dev - s.proxy) / dt;
-    s.proxy = dev, s.force = Vec3::Zero();
+    s.proxy = dev, s.surface_proxy = dev, s.force = Vec3::Zero(), s.held = {};
     return;
   }
   const double r = std::max(0.0, double(m.tip_radius_mm));
@@ -478,7 +489,7 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
     p = node(s, grasped);
     s.active |= kTermGrasp;
   } else {
-    std::array<Plane, kHapticMaxContacts + 1> planes;
+    Planes planes;
     uint32_t np = 0;
     nc = 0;
     gather_contacts(s, sc, dev, r, st, contacts, nc);
@@ -493,7 +504,26 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
       }
     };
     build(dev);
+    const uint32_t first_sphere = np;
+    if (m.sphere_count > 0) {
+      Planes rigid;
+      double unused = 0;
+      const uint32_t nq = detail::add_sphere_planes(m, s.surface_proxy, dev, r, st.rigid_ratio * kc,
+                                                    rigid, 0, unused);
+      s.surface_proxy = solve_proxy(dev, s.surface_proxy, kc, r, rigid, nq);
+      np =
+          detail::add_sphere_planes(m, s.surface_proxy, dev, r, 0.0, planes, np, s.sphere_depth_mm);
+    } else {
+      s.surface_proxy = dev;
+    }
     p = solve_proxy(dev, s.proxy, kc, r, planes, np);
+    for (uint32_t j = first_sphere; j < np; ++j) {
+      const double pen = r - planes[j].normal.dot(p - planes[j].point);
+      if (!(pen > 0)) continue;
+      s.active |= kTermSpheres;
+      if (planes[j].cap > 0 && planes[j].k * pen >= planes[j].cap * (1 - 1e-9))
+        s.active |= kTermCut;
+    }
     for (uint32_t c = 0; c < nc; ++c) {
       const double pen = r - contacts[c].normal.dot(p - contacts[c].point);
       if (pen > 0) s.active |= kTermContact, s.penetration_mm = std::max(s.penetration_mm, pen);
@@ -512,6 +542,13 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
   if (grasped < m.node_count && m.grasp_limit_mn > 0) {
     const double mag = s.force.norm(), limit = m.grasp_limit_mn;
     if (mag > limit) s.force *= limit / mag;
+  }
+  // A held fragment hangs from the proxy (held_load.cpp); its load goes to the hand.
+  if (m.held.held) {
+    s.force += detail::held_load(m.held, p, s.proxy_velocity, st, s.held);
+    s.active |= kTermHeld;
+  } else {
+    s.held = {};
   }
 
   // The god-object's memory: a triangle's side changes only when the proxy has gone round it —
@@ -610,12 +647,16 @@ void adopt_model(const HapticTool& model, HapticToolState& state, const HapticSe
   if (next.model.node_count > kHapticMaxNodes) next.model.node_count = kHapticMaxNodes;
   if (next.model.triangle_count > kHapticMaxTriangles)
     next.model.triangle_count = kHapticMaxTriangles;
+  if (next.model.sphere_count > kHapticMaxSpheres) next.model.sphere_count = kHapticMaxSpheres;
   next.live = true;
   reset_nodes(next);
   const bool carry = cur.live && cur.model.present;
   next.proxy = carry ? cur.proxy : Vec3(model.tip_mm[0], model.tip_mm[1], model.tip_mm[2]);
   next.proxy_velocity = carry ? cur.proxy_velocity : Vec3::Zero();
+  next.surface_proxy = carry ? cur.surface_proxy : next.proxy;
   next.force = cur.live ? cur.force : Vec3::Zero();
+  // The same fragment still held: it keeps swinging where it was.
+  next.held = cur.live && cur.model.held.held && model.held.held ? cur.held : HeldLoadState{};
   init_sides(next, state.scratch);
   if (cur.live && settings.blend_ms > 0) {
     state.blending = true, state.slewing = true, state.blend_weight = 0.0;
@@ -641,7 +682,8 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
   if (&model != &nw.model &&
       (!nw.live || model.present != nw.model.present || model.node_count != nw.model.node_count ||
        model.triangle_count != nw.model.triangle_count ||
-       model.grasped_node != nw.model.grasped_node)) {
+       model.grasped_node != nw.model.grasped_node || model.sphere_count != nw.model.sphere_count ||
+       model.held.held != nw.model.held.held)) {
     adopt_model(model, state, settings);
   }
   HapticSlot& cur = state.slot[state.newest];
@@ -696,6 +738,8 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
   out.proxy_mm = cur.proxy;
   out.penetration_mm = cur.penetration_mm;
   out.lens_depth_mm = cur.lens_depth_mm;
+  out.sphere_depth_mm = cur.sphere_depth_mm;
+  out.held_load_mn = cur.held.load;
   out.blend_weight = state.blend_weight;
   out.solver_iterations = cur.iterations;
   return out;

@@ -25,6 +25,10 @@
 //      each an exact 3×3 solve, with backtracking on the energy);
 //   4. force F = −k_c·(D − P) − b_c·(V_D − V_P), clamped to the device's maximum; a grasp's at
 //      most the model's grasp_limit_mn (the held flap tears there: systems/tear's resistance).
+// Lens material (issue 19 item 5, sphere_contacts.cpp): the published spheres enter step 3 as
+// planes tangent to each sphere facing the proxy, shared like the patch's facets, each with its
+// stiffness and, under ultrasound, a force bound (a plane's energy turns linear past it: the tip
+// cuts through). A held fragment (held_load.cpp) adds its load to step 4's force.
 // A new model is crossfaded in (both models ticked, forces mixed linearly over blend_ms, the
 // output's change per tick beyond the models' own bounded by blend_max_step_mn until it has caught
 // up), so the force is continuous; a stalled simulation leaves the last model running.
@@ -64,21 +68,34 @@ struct HapticSettings {
   // sleep through the tick (no solve): an idle tool costs a spring pass only.
   double sleep_force_mn = 1e-4;
   NodeIntegrator integrator = NodeIntegrator::ImplicitEuler;
+  // A held fragment hangs from the tip by this spring, critically damped (held_load.cpp): stiff
+  // against the fragment's weight (its sag W/k_h is microns), soft against k_c.
+  double held_stiffness_mn_per_mm = 20.0;
 };
 
 // Which terms the force came from (bits of HapticForce::active).
-enum HapticTerm : uint8_t { kTermContact = 1, kTermGrasp = 2, kTermLens = 4, kTermBlend = 8 };
+enum HapticTerm : uint8_t {
+  kTermContact = 1,
+  kTermGrasp = 2,
+  kTermLens = 4,
+  kTermBlend = 8,
+  kTermSpheres = 16,  // lens material (spheres) pressed
+  kTermCut = 32,      // ... and its reaction at the ultrasound cut bound
+  kTermHeld = 64      // a held fragment's load
+};
 
 struct HapticForce {
   Vec3 force_mn = Vec3::Zero();  // to the device, clamped
   Vec3 proxy_mm = Vec3::Zero();  // of the newest model
   double penetration_mm = 0;     // deepest patch contact of the proxy's tip sphere (newest model)
   double lens_depth_mm = 0;      // d of seed 003 §E.5 at the proxy (newest model)
-  double blend_weight = 1;       // weight of the newest model, 0..1
-  uint8_t active = 0;            // HapticTerm bits
-  bool clamped = false;          // the force hit max_force_mn
-  bool input_rejected = false;   // NaN/inf device sample: zero force, state untouched
-  int solver_iterations = 0;     // CG iterations of the newest model this tick
+  double sphere_depth_mm = 0;    // deepest sphere penetration of the device's tip (newest model)
+  Vec3 held_load_mn = Vec3::Zero();  // a held fragment's load in the force (newest model)
+  double blend_weight = 1;           // weight of the newest model, 0..1
+  uint8_t active = 0;                // HapticTerm bits
+  bool clamped = false;              // the force hit max_force_mn
+  bool input_rejected = false;       // NaN/inf device sample: zero force, state untouched
+  int solver_iterations = 0;         // CG iterations of the newest model this tick
 };
 
 // Lens penetration (seed 003 §E.5) of a sphere of radius r at p into the two half-ellipsoids of
@@ -106,6 +123,13 @@ struct HapticContact {
   double weight = 0;            // its share of the contact (Σ ≤ 1; = 1 over faces)
 };
 
+// A held fragment's motion (held_load.cpp), per slot.
+struct HeldLoadState {
+  bool live = false;                        // following a held fragment
+  Vec3 x = Vec3::Zero(), v = Vec3::Zero();  // fragment's centre, mm, mm/s
+  Vec3 load = Vec3::Zero();                 // on the tip last tick, mN
+};
+
 // One model being integrated: its own copy of the model (so the triple buffer's slot can be
 // handed back at once) and the nodes' state.
 struct HapticSlot {
@@ -115,8 +139,10 @@ struct HapticSlot {
   std::array<double, 3 * kHapticMaxNodes> warm_dv{};  // the last Δv, CG's first guess
   std::array<int8_t, kHapticMaxTriangles> side{};     // +1/−1: the tool's side of each triangle
   Vec3 proxy = Vec3::Zero(), proxy_velocity = Vec3::Zero();  // mm, mm/s
-  Vec3 force = Vec3::Zero();                                 // this model's force last tick, mN
-  double penetration_mm = 0, lens_depth_mm = 0;
+  Vec3 surface_proxy = Vec3::Zero();  // on the lens material's surface (proxy_planes.hpp), mm
+  Vec3 force = Vec3::Zero();          // this model's force last tick, mN
+  double penetration_mm = 0, lens_depth_mm = 0, sphere_depth_mm = 0;
+  HeldLoadState held;
   uint8_t active = 0;
   int iterations = 0;
 };
@@ -157,8 +183,9 @@ struct HapticToolState {
 void adopt_model(const HapticTool& model, HapticToolState& state, const HapticSettings& settings);
 
 // One tick. `model` is the newest model as last given to adopt_model (the state integrates its own
-// copy; if `model` visibly differs from it — presence, node or triangle count, grasped node — it
-// is adopted first). Device position mm, velocity mm/s (a NaN/inf sample: zero force, state kept).
+// copy; if `model` visibly differs from it — presence, node, triangle or sphere count, grasped
+// node, held fragment — it is adopted first). Device position mm, velocity mm/s (a NaN/inf sample:
+// zero force, state kept).
 HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
                         const Vec3& device_vel_mm_s, const HapticSettings& settings,
                         HapticToolState& state);

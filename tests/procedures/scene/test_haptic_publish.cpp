@@ -9,27 +9,23 @@
 #include <limits>
 #include <set>
 
+#include "components/held_fragment.hpp"
 #include "components/particles.hpp"
 #include "components/tool.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/haptic_publish.hpp"
+#include "procedures/scene/lens_fragments.hpp"
+#include "procedures/scene/lens_sculpting.hpp"
 #include "procedures/scene/scene.hpp"
 #include "systems/haptic_model/haptic_model.hpp"
+#include "tests/support/capture_port.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
 namespace {
 
-// A haptic runtime stand-in: no device, keeps the last published model.
-class CapturePort final : public HapticPort {
- public:
-  bool newest_pose(Hand, ToolPose&) override { return false; }
-  HapticModel& model_slot() override { return slot; }
-  void publish_model() override { ++published, last_sequence = slot.sequence; }
-  HapticModel slot;
-  uint64_t published = 0, last_sequence = 0;
-};
+using test::CapturePort;
 
 std::unique_ptr<Scene> scene_at(const char* scenario, double t_s, CapturePort& port) {
   const Scenario s = test::repo_scenario(scenario);
@@ -272,21 +268,131 @@ TEST(HapticPublish, TheBallGrowsWithTheHopsAndStaysWithinCapacity) {
   for (uint32_t l = 0; l < a.node_count; ++l) EXPECT_EQ(a.x[l], b.x[l]);
 }
 
-TEST(HapticPublish, TheSculptingProbeFeelsNoLensButTheScenesOtherToolsDo) {
+// Issue 19 item 5: the sculpted lens is published as spheres of its material near every tip — the
+// alive surface tets within reach, turned with the nucleus, nearest first, none of the sculpted
+// ones — and the probe at pedal 3 carries the cut force; the analytic lens is not sent.
+TEST(HapticPublish, TheSculptedLensComesAsSpheresOfItsMaterialNearTheTip) {
   CapturePort port;
-  auto scene = scene_at("phaco_sculpting_demo.json", 1.0 / 60.0, port);
+  // At 9 s the demo's probe is in its first trench with ultrasound on.
+  auto scene = scene_at("phaco_sculpting_demo.json", 9.0, port);
+  const Entity lens = *scene->body(BodyPart::Lens);
+  const LensSculpting& ls = scene->world.at<LensSculpting>(lens);
+  ASSERT_LT(ls.topology.alive_count, ls.topology.tet_count) << "the demo has sculpted by 9 s";
+  const HapticPublishSettings settings = haptic_publish_settings(*scene);
   bool saw_probe = false;
-  for (const HapticTool& t : port.slot.tools) {
-    if (!t.present) continue;
-    if (t.tool_kind == static_cast<uint8_t>(ToolKind::PhacoProbe)) {
+  for (Entity e : scene->tools) {
+    const HapticTool& t = port.slot.tools[static_cast<size_t>(scene->world.at<Tool>(e).hand)];
+    ASSERT_TRUE(t.present);
+    EXPECT_FALSE(t.lens_present) << "the sculpted lens is not the analytic ellipsoid any more";
+    const ToolState& pose = scene->world.at<ToolState>(e);
+    const double reach = t.tip_radius_mm + settings.lens.reach_mm;
+    const double c = std::cos(ls.rotation.angle_rad), sn = std::sin(ls.rotation.angle_rad);
+    // Every alive surface tet within reach (brute force over the mesh), in the world.
+    std::vector<std::pair<double, Vec3>> expected;
+    for (uint32_t k = 0; k < ls.topology.tet_count; ++k) {
+      if (!ls.topology.alive[k] || ls.topology.surface_slot[k] == kNoTet) continue;
+      const Vec3 r = sculpt::tet_centre(ls.topology, k);
+      const Vec3 w(c * r.x() - sn * r.y(), sn * r.x() + c * r.y(), r.z());
+      const double radius = std::cbrt(3.0 * ls.topology.volume[k] / (4.0 * 3.14159265358979));
+      const double gap = (w - pose.pos).norm() - radius;
+      if (gap <= reach) expected.emplace_back(gap, w);
+    }
+    std::sort(expected.begin(), expected.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    EXPECT_EQ(t.sphere_count, std::min<size_t>(expected.size(), kHapticMaxSpheres));
+    double last_gap = -1e9;
+    for (uint32_t j = 0; j < t.sphere_count; ++j) {
+      const Vec3 centre(t.sphere_x[j], t.sphere_y[j], t.sphere_z[j]);
+      const double gap = (centre - pose.pos).norm() - t.sphere_r[j];
+      EXPECT_LE(gap, reach + 1e-4);
+      EXPECT_GE(gap, last_gap - 1e-4) << "nearest first";
+      last_gap = gap;
+      const bool found = std::any_of(expected.begin(), expected.end(), [&](const auto& x) {
+        return (x.second - centre).norm() < 1e-4;
+      });
+      EXPECT_TRUE(found) << "sphere " << j << " is an alive surface tet";
+      EXPECT_GT(t.sphere_r[j], 0.0f);
+      EXPECT_NEAR(t.sphere_k[j] / settings.lens.stiffness_mn_mm, 1.0, 0.5 + 1e-6)
+          << "k_f at the standard hardness (the cortex at half)";
+    }
+    if (scene->world.at<Tool>(e).kind == ToolKind::PhacoProbe) {
       saw_probe = true;
-      EXPECT_FALSE(t.lens_present) << "the probe sculpts the lens on purpose";
+      EXPECT_GT(t.sphere_count, 10u) << "the probe is in the lens";
       EXPECT_NEAR(t.tip_radius_mm, 0.45f, 1e-6);
+      if (pose.pedal >= 3.0)
+        EXPECT_NEAR(t.cut_force_mn, settings.lens.cut_force_mn, 1e-4) << "standard eye, power 1";
+      else
+        EXPECT_EQ(t.cut_force_mn, 0.0f);
     } else {
-      EXPECT_TRUE(t.lens_present);
+      EXPECT_EQ(t.cut_force_mn, 0.0f) << "only the probe's ultrasound cuts";
     }
   }
   EXPECT_TRUE(saw_probe);
+}
+
+// The fragment lens: boundary cells near the tip, and a held fragment's record copied as is with
+// its own cells left out (they ride the tip).
+TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsRecord) {
+  CapturePort port;
+  Scenario s = test::repo_scenario("phaco_sculpting_demo.json");
+  s.eye.level = 0;
+  s.methods["lens.model"] = "fragments";
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  o.haptics = &port;
+  auto scene = build_scene(s, o);
+  for (int f = 0; f < int(9.0 / s.dt_s); ++f) step(*scene);
+  const Entity lens = *scene->body(BodyPart::Lens);
+  const LensFragments& lf = scene->world.at<LensFragments>(lens);
+  Entity probe{};
+  for (Entity e : scene->tools)
+    if (scene->world.at<Tool>(e).kind == ToolKind::PhacoProbe) probe = e;
+  const ToolState& pose = scene->world.at<ToolState>(probe);
+  const HapticTool& t = port.slot.tools[static_cast<size_t>(scene->world.at<Tool>(probe).hand)];
+  ASSERT_GT(t.sphere_count, 0u);
+  EXPECT_FALSE(t.lens_present);
+  auto is_boundary_cell = [&](const Vec3& centre) {
+    for (uint32_t c = 0; c < lf.lens.cells.size(); ++c) {
+      if (!lf.lens.cells.alive[c]) continue;
+      if (Vec3(lf.lens.cells.x[c], lf.lens.cells.y[c], lf.lens.cells.z[c]) != centre) continue;
+      for (uint32_t k = 0; k < 4; ++k)
+        if (lf.lens.cells.neighbour[c][k] == kNoSimplex) return true;
+    }
+    return false;
+  };
+  for (uint32_t j = 0; j < t.sphere_count; ++j) {
+    const Vec3 centre(t.sphere_x[j], t.sphere_y[j], t.sphere_z[j]);
+    EXPECT_TRUE(is_boundary_cell(centre)) << j;
+    EXPECT_LE((centre - pose.pos).norm() - t.sphere_r[j],
+              t.tip_radius_mm + haptic_publish_settings(*scene).lens.reach_mm + 1e-4);
+  }
+
+  // The drill's aspiration holds fragment 0 at the probe (synthetic: set as its code would).
+  HeldFragment held;
+  held.held = true;
+  held.fragment = 0;
+  held.mass_kg = 4e-5f;
+  held.drag_mn_s_per_mm = 0.04f;
+  held.weight_mn = {0, 0, -0.03f};
+  held.hold_limit_mn = 11.0f;
+  scene->world.add(probe, held);
+  HapticPublishScratch scratch;
+  HapticModel m;
+  build_haptic_model(*scene, haptic_publish_settings(*scene), scratch, m);
+  const HapticTool& h = m.tools[static_cast<size_t>(scene->world.at<Tool>(probe).hand)];
+  EXPECT_TRUE(h.held.held);
+  EXPECT_EQ(h.held.fragment, 0u);
+  EXPECT_EQ(h.held.mass_kg, 4e-5f);
+  EXPECT_EQ(h.held.hold_limit_mn, 11.0f);
+  if (lf.lens.fragments.count == 1) EXPECT_EQ(h.sphere_count, 0u) << "the whole lens is held";
+  for (uint32_t j = 0; j < h.sphere_count; ++j) {
+    const Vec3 centre(h.sphere_x[j], h.sphere_y[j], h.sphere_z[j]);
+    for (uint32_t c = 0; c < lf.lens.cells.size(); ++c) {
+      if (Vec3(lf.lens.cells.x[c], lf.lens.cells.y[c], lf.lens.cells.z[c]) == centre &&
+          lf.lens.cells.alive[c])
+        EXPECT_NE(lf.lens.fragments.label[c], 0u) << "the held fragment's cells ride the tip";
+    }
+  }
 }
 
 }  // namespace

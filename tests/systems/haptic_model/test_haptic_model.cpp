@@ -452,6 +452,19 @@ TEST(HapticModel, TicksAndAdoptsDoNotAllocate) {
   grasped->lens_present = true;
   grasped->lens_stiffness_mn_per_mm = 20;
   grasped->lens_centre_mm = {0, 0, -2};
+  // Lens material below the sheet and a held fragment (issue 19 item 5) on the same path.
+  for (int i = 0; i < 64; ++i) {
+    const uint32_t j = sheet->sphere_count++;
+    sheet->sphere_x[j] = float(0.2 * (i % 8) - 0.7),
+    sheet->sphere_y[j] = float(0.2 * (i / 8) - 0.7);
+    sheet->sphere_z[j] = -0.3f, sheet->sphere_r[j] = 0.15f, sheet->sphere_k[j] = 100.0f;
+  }
+  sheet->cut_force_mn = 20.0f;
+  sheet->held = {.held = true,
+                 .mass_kg = 4e-5f,
+                 .drag_mn_s_per_mm = 0.1f,
+                 .weight_mn = {0, 0, -0.03f},
+                 .hold_limit_mn = 11.0f};
   auto st = fresh(*sheet, s);
   const uint64_t before = g_allocations.load(std::memory_order_relaxed);
   for (int k = 0; k < 300; ++k) {

@@ -1,0 +1,143 @@
+#include "procedures/scene/haptic_lens_contacts.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "components/held_fragment.hpp"
+#include "components/tets.hpp"
+#include "components/tool.hpp"
+#include "procedures/scene/lens_fragments.hpp"
+#include "procedures/scene/lens_sculpting.hpp"
+#include "procedures/scene/scene.hpp"
+
+namespace phaco {
+namespace {
+
+constexpr double kStandardHardness = 0.5;  // data/eye/standard_eye.json lens_model.nucleus_hardness
+constexpr double kPi = 3.14159265358979323846;
+
+double equal_volume_radius(double volume_mm3) {
+  return std::cbrt(3.0 * std::max(0.0, volume_mm3) / (4.0 * kPi));
+}
+
+// The scratch's candidates, nearest first, into the tool's spheres (at most its capacity).
+template <class Sphere>
+void keep_nearest(HapticLensScratch& s, HapticTool& t, Sphere&& sphere) {
+  const size_t keep = std::min<size_t>(s.near.size(), kHapticMaxSpheres);
+  std::partial_sort(s.near.begin(), s.near.begin() + static_cast<std::ptrdiff_t>(keep),
+                    s.near.end());
+  t.sphere_count = static_cast<uint32_t>(keep);
+  for (size_t k = 0; k < keep; ++k) sphere(s.near[k].second, static_cast<uint32_t>(k));
+}
+
+// Tets lens (seed 000 §5.3): surface tets near the tip, from the sculpting's broadphase in the
+// lens's rest frame, turned by the nucleus angle.
+void tet_spheres(const Scene& scene, const LensSculpting& ls, const Vec3& tip, double reach,
+                 const HapticLensSettings& settings, HapticLensScratch& s, HapticTool& t) {
+  const Tets* tets = scene.world.get<Tets>(*scene.body(BodyPart::Lens));
+  const double angle = ls.rotation.angle_rad, c = std::cos(angle), sn = std::sin(angle);
+  const Vec3 local(c * tip.x() + sn * tip.y(), -sn * tip.x() + c * tip.y(), tip.z());
+  const sculpt::TipCapsule query{local, local, reach};
+  s.candidates.clear();
+  sculpt::BroadphaseStats stats;
+  if (ls.sculpt.options.broadphase == sculpt::Broadphase::Octree) {
+    sculpt::octree_candidates(ls.sculpt.octree, ls.topology, query, s.queue, s.candidates, stats);
+  } else {
+    ls.sculpt.dbvt.candidates(ls.topology, query, s.candidates, stats);
+  }
+  std::sort(s.candidates.begin(), s.candidates.end());  // a fixed order, whatever the broadphase
+  s.near.clear();
+  const TetTopology& topo = ls.topology;
+  for (uint32_t e : s.candidates) {
+    if (e >= topo.tet_count || !topo.alive[e] || topo.surface_slot[e] == kNoTet) continue;
+    const Vec3 centre = sculpt::tet_centre(topo, e);
+    const double gap = (centre - local).norm() - equal_volume_radius(topo.volume[e]);
+    if (gap > reach) continue;
+    s.near.emplace_back(static_cast<float>(gap), e);
+  }
+  const double h = settings.nucleus_hardness;
+  keep_nearest(s, t, [&](uint32_t e, uint32_t k) {
+    const Vec3 r = sculpt::tet_centre(topo, e);
+    t.sphere_x[k] = static_cast<float>(c * r.x() - sn * r.y());
+    t.sphere_y[k] = static_cast<float>(sn * r.x() + c * r.y());
+    t.sphere_z[k] = static_cast<float>(r.z());
+    t.sphere_r[k] = static_cast<float>(equal_volume_radius(topo.volume[e]));
+    const bool nucleus = !tets || e >= tets->region.size() || tets->region[e] != 0;
+    t.sphere_k[k] =
+        static_cast<float>(settings.stiffness_mn_mm * (nucleus ? h : 0.5 * h) / kStandardHardness);
+  });
+}
+
+// Fragment lens (seed 002 §4): alive cells with an external face, less the held fragment's.
+void cell_spheres(const LensFragments& lf, const Vec3& tip, double reach, uint32_t held_fragment,
+                  const HapticLensSettings& settings, HapticLensScratch& s, HapticTool& t) {
+  const SimplexCells& cells = lf.lens.cells;
+  const std::vector<uint32_t>& label = lf.lens.fragments.label;
+  s.near.clear();
+  for (uint32_t e = 0; e < cells.size(); ++e) {
+    if (!cells.alive[e]) continue;
+    const auto& nb = cells.neighbour[e];
+    if (nb[0] != kNoSimplex && nb[1] != kNoSimplex && nb[2] != kNoSimplex && nb[3] != kNoSimplex)
+      continue;  // inside its fragment
+    if (held_fragment != kNoSimplex && e < label.size() && label[e] == held_fragment) continue;
+    const double dx = cells.x[e] - tip.x(), dy = cells.y[e] - tip.y(), dz = cells.z[e] - tip.z();
+    const double gap =
+        std::sqrt(dx * dx + dy * dy + dz * dz) - equal_volume_radius(cells.volume[e]);
+    if (gap > reach) continue;
+    s.near.emplace_back(static_cast<float>(gap), e);
+  }
+  keep_nearest(s, t, [&](uint32_t e, uint32_t k) {
+    t.sphere_x[k] = cells.x[e], t.sphere_y[k] = cells.y[e], t.sphere_z[k] = cells.z[e];
+    t.sphere_r[k] = static_cast<float>(equal_volume_radius(cells.volume[e]));
+    const double h = e < lf.lens.hardness.size() ? lf.lens.hardness[e] : settings.nucleus_hardness;
+    t.sphere_k[k] = static_cast<float>(settings.stiffness_mn_mm * h / kStandardHardness);
+  });
+}
+
+}  // namespace
+
+HapticLensSettings haptic_lens_settings(const Scene& scene) {
+  HapticLensSettings s;
+  s.reach_mm = scene.params.get("haptic_model.contact_radius_mm");
+  s.stiffness_mn_mm = scene.params.get("haptic_model.lens_stiffness_mn_mm");
+  s.cut_force_mn = scene.params.get("haptic_model.cut_force_mn");
+  s.nucleus_hardness = scene.params.get("lens_model.nucleus_hardness");
+  s.ultrasound_power = scene.params.get("lens_model.ultrasound_power");
+  return s;
+}
+
+bool has_sculptable_lens(const Scene& scene) {
+  const auto lens = scene.body(BodyPart::Lens);
+  return lens && (scene.world.get<LensSculpting>(*lens) || scene.world.get<LensFragments>(*lens));
+}
+
+void fill_lens_contacts(const Scene& scene, Entity tool, const HapticLensSettings& settings,
+                        HapticLensScratch& scratch, HapticTool& t) {
+  t.sphere_count = 0;
+  t.cut_force_mn = 0;
+  t.held = {};
+  const auto lens = scene.body(BodyPart::Lens);
+  if (!lens) return;
+  const ToolState& pose = *scene.world.get<ToolState>(tool);
+  if (const HeldFragment* held = scene.world.get<HeldFragment>(tool); held && held->held)
+    t.held = *held;
+  const double reach = t.tip_radius_mm + settings.reach_mm;
+  if (const LensSculpting* ls = scene.world.get<LensSculpting>(*lens)) {
+    tet_spheres(scene, *ls, pose.pos, reach, settings, scratch, t);
+  } else if (const LensFragments* lf = scene.world.get<LensFragments>(*lens)) {
+    cell_spheres(*lf, pose.pos, reach, t.held.held ? t.held.fragment : kNoSimplex, settings,
+                 scratch, t);
+  } else {
+    return;
+  }
+  // Seed 000 §5.3 / seed 002 §4: ultrasound at pedal 3 only (sculpt_radius_mm, ultrasound_power).
+  const bool ultrasound =
+      scene.world.get<Tool>(tool)->kind == ToolKind::PhacoProbe && pose.pedal >= 3.0;
+  if (ultrasound) {
+    t.cut_force_mn =
+        static_cast<float>(settings.cut_force_mn * settings.nucleus_hardness / kStandardHardness /
+                           std::max(0.25, settings.ultrasound_power));
+  }
+}
+
+}  // namespace phaco

@@ -1,0 +1,66 @@
+#pragma once
+// Publish phase, the lens's half of a tool's haptic model (issue 19 item 5): the lens material
+// near each tool's tip as contact spheres (components/haptic_model.hpp, HapticTool::sphere_*),
+// for any tool — the sculpting probe, a second instrument, the chopper when it lands — and the
+// tool's held fragment (components/held_fragment.hpp) when the drill's aspiration fills one.
+//
+//   lens.model tets       the alive tets with an exposed face (TetTopology's surface list) whose
+//                         spheres come within haptic_model.contact_radius_mm of the tip sphere,
+//                         found with the sculpting's own broadphase (octree or btDbvt over the
+//                         rest shape), turned by the nucleus angle into the world
+//   lens.model fragments  the alive simplex cells with an external face, at their current centres
+//                         (a scan of the cell centres: the lens has no spatial index; ≈ 10 µs per
+//                         tool at level 3), less the held fragment's own cells
+//
+// Each sphere: the element's centroid, its equal-volume radius (3V/4π)^⅓, and the stiffness
+// k = k_f·h/0.5 — seed 003 §E.5's k_f (haptic_model.lens_stiffness_mn_mm) at the standard
+// nucleus hardness h = 0.5, in proportion to the hardness (lens_model.nucleus_hardness; the
+// cortex at half of it, as the fragment lens has it). Why k_f and not a tissue modulus: what the
+// hand feels pushing a nucleus is the whole nucleus held in its bag (seed 000 §5.4 turns it, seed
+// 003 renders it with k_f); a Hertz contact of the 0.45 mm tip on lens tissue is far softer
+// (G from ~10 Pa in young nuclei to ~10⁴ times more at 78 years, Weeber et al. 2007, Graefes Arch
+// Clin Exp Ophthalmol 245:1357), so the cell-level stiffness is not the felt one.
+//
+// Under ultrasound (the phaco probe at pedal 3) the tip cuts: the material's whole reaction is
+// bounded by cut_force = haptic_model.cut_force_mn · (h / 0.5) / power (a harder nucleus or less
+// power: more push needed), the rest of the press goes into the cut (seed 000 §5.3 removes what
+// the tip reaches at the next frame).
+//
+// Nearest first, at most kHapticMaxSpheres. Reads: tools.pose, tools.held, lens.sculpting,
+// lens.tets, lens.cells. Allocation-free once the scratch has grown.
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "components/haptic_model.hpp"
+#include "engine/core/math.hpp"
+#include "engine/ecs/world.hpp"
+
+namespace phaco {
+
+struct Scene;
+
+struct HapticLensSettings {
+  double reach_mm = 1.0;          // haptic_model.contact_radius_mm
+  double stiffness_mn_mm = 100;   // k_f at the standard hardness
+  double cut_force_mn = 20;       // haptic_model.cut_force_mn at standard hardness, power 1
+  double nucleus_hardness = 0.5;  // lens_model.nucleus_hardness
+  double ultrasound_power = 1.0;  // lens_model.ultrasound_power
+};
+
+struct HapticLensScratch {
+  std::vector<uint32_t> queue, candidates;
+  std::vector<std::pair<float, uint32_t>> near;  // squared distance to the tip, element
+};
+
+HapticLensSettings haptic_lens_settings(const Scene& scene);
+
+// True when the scene's lens is one the tools change (sculpted or fragmenting): its spheres
+// replace the analytic lens of seed 003 §E.5.
+bool has_sculptable_lens(const Scene& scene);
+
+// Fills t's spheres, cut force and held fragment for the tool entity `tool` (tip at its pose).
+void fill_lens_contacts(const Scene& scene, Entity tool, const HapticLensSettings& settings,
+                        HapticLensScratch& scratch, HapticTool& t);
+
+}  // namespace phaco
