@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
+#include <optional>
 
 #include "components/from_mesh.hpp"
+#include "components/held_fragment.hpp"
 #include "components/particles.hpp"
 #include "components/tets.hpp"
 #include "components/tool.hpp"
@@ -21,6 +24,29 @@ constexpr double kKgPerMm3PerKgPerM3 = 1e-9;
 constexpr double kRhexisRadiusMm = 2.6;
 constexpr double kGrooveWidthTipDiameters = 1.5;  // the sculpting drill's trench (DESIGN.md §6)
 constexpr double kGrooveDepthFraction = 0.8;
+
+// The held fragment as the hand feels it (components/held_fragment.hpp; issue 19 item 5): its
+// mass, its weight less buoyancy (the medium's reduced g), Stokes drag 6πμR of its equal-volume
+// sphere in balanced salt solution (μ = 1 mPa·s = 1e-6 mN·s/mm²) and the occlusion's grip, the
+// vacuum's pull on the port.
+constexpr double kBssViscosityMnSPerMm2 = 1e-6;
+
+HeldFragment held_load_of(const lens::FragmentLens& l, const lens::FragmentLensStats& st) {
+  HeldFragment h;
+  if (!st.held || l.held_fragment >= l.fragments.count) return h;
+  const double m = l.fragments.mass[l.held_fragment];
+  const double volume_mm3 = m / l.settings.density_kg_mm3;
+  const double r = std::cbrt(3.0 * volume_mm3 / (4.0 * std::numbers::pi));
+  h.held = true;
+  h.fragment = l.held_fragment;
+  h.mass_kg = static_cast<float>(m);
+  h.drag_mn_s_per_mm = static_cast<float>(6.0 * std::numbers::pi * kBssViscosityMnSPerMm2 * r);
+  // kg · mm/s² = mN.
+  h.weight_mn = {0.0f, 0.0f, static_cast<float>(-m * l.settings.fluid.gravity_mm_s2)};
+  h.hold_limit_mn =
+      static_cast<float>(lens_tools::holding_force_mn(st.vacuum_mmhg, l.settings.fluid));
+  return h;
+}
 
 uint32_t count_pieces(const lens::FragmentLens& l) {
   uint32_t n = 0;
@@ -114,27 +140,35 @@ void add_lens_fragments(Scene& scene) {
   lf.rng = CounterRng(scene.scenario.seed, 5);
   lf.ultrasound_power = std::min(1.0, params.get("lens_model.ultrasound_power"));
   lf.previous_pose.resize(scene.tools.size());
-  for (size_t i = 0; i < scene.tools.size(); ++i)
+  for (size_t i = 0; i < scene.tools.size(); ++i) {
     lf.previous_pose[i] = scene.world.at<ToolState>(scene.tools[i]);
+    // The probe carries what it holds, for the haptic thread (haptic_publish reads it).
+    if (lf.nucleus_removal && scene.world.at<Tool>(scene.tools[i]).kind == ToolKind::PhacoProbe)
+      scene.world.add(scene.tools[i], HeldFragment{});
+  }
   scene.world.name_component<LensFragments>("cells");
   scene.world.add(e, std::move(lf));
 }
 
 SystemDesc lens_fragments_system(Scene& scene) {
   const Entity e = *scene.body(BodyPart::Lens);
+  std::vector<std::string> writes = {"lens.cells", "lens.tets"};
+  if (scene.world.at<LensFragments>(e).nucleus_removal) writes.push_back("tools.held");
   return {.name = "lens_fragments",
           .phase = Phase::Dynamics,
           .reads = {"tools.pose"},
-          .writes = {"lens.cells", "lens.tets"},
+          .writes = std::move(writes),
           .run = [&scene, e](const FrameContext& ctx) {
             LensFragments& lf = scene.world.at<LensFragments>(e);
             lens::LensTools tools;
             double power = 0;
+            std::optional<Entity> probe;
             for (size_t i = 0; i < scene.tools.size(); ++i) {
               const Entity te = scene.tools[i];
               const ToolState& pose = scene.world.at<ToolState>(te);
               switch (scene.world.at<Tool>(te).kind) {
                 case ToolKind::PhacoProbe: {
+                  probe = te;
                   power = lens_tools::ultrasound_power(pose.pedal, lf.ultrasound_power);
                   if (power > 0) tools.phaco = lens_tools::phaco_tip(pose, lf.ultrasound_power);
                   if (pose.pedal >= 2.0)
@@ -178,11 +212,14 @@ SystemDesc lens_fragments_system(Scene& scene) {
               }
               lf.pieces = count_pieces(lf.lens);
               lf.pieces_max = std::max(lf.pieces_max, lf.pieces);
+              if (probe) scene.world.at<HeldFragment>(*probe) = held_load_of(lf.lens, st);
             }
             const double ms =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
             lf.ms_total += ms, lf.ms_max = std::max(lf.ms_max, ms);
+            lf.contact_pairs_total += st.contact_pairs;
+            lf.contact_pairs_max = std::max(lf.contact_pairs_max, st.contact_pairs);
             if (lf.lens.awake) ++lf.frames_awake;
             if (lf.lens.cells_removed != removed_before) {
               Tets& tets = scene.world.at<Tets>(e);
@@ -208,6 +245,9 @@ nlohmann::json lens_fragments_summary(Scene& scene) {
   j["frames_awake"] = lf->frames_awake;
   j["step_ms_mean"] = scene.frame ? lf->ms_total / double(scene.frame) : 0.0;
   j["step_ms_max"] = lf->ms_max;
+  j["contact_pairs_mean"] =
+      scene.frame ? double(lf->contact_pairs_total) / double(scene.frame) : 0.0;
+  j["contact_pairs_max"] = lf->contact_pairs_max;
   bool finite = true;
   for (uint32_t c = 0; c < l.cells.size(); ++c)
     if (l.cells.alive[c])

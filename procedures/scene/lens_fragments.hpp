@@ -36,6 +36,9 @@ struct LensFragments {
   std::vector<ToolPose> previous_pose;  // per scene tool, last frame (the hook's velocity)
   uint64_t frames_awake = 0;
   double ms_total = 0, ms_max = 0;
+  // SPH fragment contact (seed 002 §6.1): particle pairs tested, over the frames, and the most in
+  // one frame; fragments present, the most in one frame (the sweep's cost figures).
+  uint64_t contact_pairs_total = 0, contact_pairs_max = 0;
   // The nucleus_removal drill (fluidics on).
   bool nucleus_removal = false;
   double grooved_volume_mm3 = 0, start_volume_mm3 = 0;  // the groove; the lens left after it

@@ -395,5 +395,46 @@ TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsR
   }
 }
 
+// The nucleus_removal drill's own aspiration fills the probe's held-fragment record (no synthetic
+// record): while the expert holds a quadrant, the published model carries it with its mass, its
+// weight less buoyancy, Stokes drag and the vacuum's grip, each against its formula.
+TEST(HapticPublish, TheDrillsAspirationPublishesTheQuadrantItHolds) {
+  CapturePort port;
+  Scenario s = test::repo_scenario("nucleus_removal_expert.json");
+  s.eye.level = 0;
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  o.haptics = &port;
+  auto scene = build_scene(s, o);
+  const Entity lens = *scene->body(BodyPart::Lens);
+  Entity probe{};
+  for (Entity e : scene->tools)
+    if (scene->world.at<Tool>(e).kind == ToolKind::PhacoProbe) probe = e;
+  const size_t hand = static_cast<size_t>(scene->world.at<Tool>(probe).hand);
+  int held_frames = 0;
+  for (uint64_t f = 0; f < static_cast<uint64_t>(s.duration_s / s.dt_s) && held_frames < 20; ++f) {
+    step(*scene);
+    const LensFragments& lf = scene->world.at<LensFragments>(lens);
+    const HeldFragment& record = scene->world.at<HeldFragment>(probe);
+    const HeldFragment& published = port.slot.tools[hand].held;
+    EXPECT_EQ(record.held, published.held) << "frame " << f;
+    if (!record.held) continue;
+    ++held_frames;
+    const lens::FragmentLens& l = lf.lens;
+    ASSERT_LT(record.fragment, l.fragments.count);
+    const double m = l.fragments.mass[record.fragment];
+    EXPECT_FLOAT_EQ(record.mass_kg, static_cast<float>(m));
+    EXPECT_FLOAT_EQ(record.weight_mn[2], static_cast<float>(-m * l.settings.fluid.gravity_mm_s2));
+    const double r = std::cbrt(3 * (m / l.settings.density_kg_mm3) / (4 * M_PI));
+    EXPECT_NEAR(record.drag_mn_s_per_mm, 6 * M_PI * 1e-6 * r, 1e-9);
+    EXPECT_FLOAT_EQ(record.hold_limit_mn, static_cast<float>(lens_tools::holding_force_mn(
+                                              l.vacuum_mmhg, l.settings.fluid)));
+    EXPECT_GT(record.hold_limit_mn, 0.0f);
+    EXPECT_EQ(published.fragment, record.fragment);
+    EXPECT_EQ(published.mass_kg, record.mass_kg);
+  }
+  EXPECT_GE(held_frames, 20) << "the expert never held a fragment";
+}
+
 }  // namespace
 }  // namespace phaco
