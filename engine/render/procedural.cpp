@@ -159,7 +159,9 @@ ToolMeshes make_tool_mesh(ToolKind kind) {
       add_tube(t.body, Vec3f(0, 0, kPhacoTipLength), Vec3f(0, 0, L), 0.65f, 0.9f);
       break;
     case ToolKind::Hook:
-      // Chopper / Sinskey hook: a 1 mm bent end on a thin shaft.
+    case ToolKind::Chopper:
+      // Chopper / Sinskey hook: a 1 mm bent end on a thin shaft (the nucleus_removal drill's
+      // second instrument, issue 19).
       add_tube(t.body, Vec3f(0, 0, 0), Vec3f(0, 1.0f, 0), 0.12f, 0.16f, 10);
       add_sphere(t.body, Vec3f(0, 1.0f, 0), 0.17f);
       add_tube(t.body, Vec3f(0, 1.0f, 0), Vec3f(0, 1.0f, L), 0.17f, 0.4f);
