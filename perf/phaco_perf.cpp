@@ -13,6 +13,7 @@
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
 //   phaco-perf sweep        issue 9: every drill at every level, thread count and method
 //   phaco-perf soak         issue 18: the trainer drill after drill; memory, GL objects, haptics
+//   phaco-perf nucleus      issue 19: the nucleus_removal expert per level, 1 and 2 threads
 //   phaco-perf records      issue 21: 1, 4, 16 stations syncing to one PostgreSQL server at once
 //   alternative,
 //                           with the haptic thread beside it; the targets; the checks CI runs
@@ -114,6 +115,11 @@ studies:
       --reference-dt-divisor change every chosen drill's recipe. About 5 minutes on an idle
       machine (11 under load). docs/perf_sweep.md says why the whole capsule
       (capsule.active_set=off) is not in it.
+  nucleus [--max-level L]
+      Issue 19, the nucleus_removal expert at levels 0..3 (--quick: 0..1; up to 5) on 1 and 2
+      threads with the haptic thread beside it: cells, fragments and SPH pairs, frame p50/p99/max,
+      the lens system's cost, the 2-thread speed-up, state hashes, and the outcome against the
+      finest level run.
   records [--pg ADMIN_URI]
       Issue 21, 1, 4 and 16 stations (processes, 200 records each) syncing to one PostgreSQL
       server at once: records per second, batch latency p50/p99/max, every record at the centre
@@ -186,6 +192,8 @@ int main(int argc, char** argv) {
       perf::run_soak(options);
     } else if (cmd == "records") {
       perf::run_records(options);
+    } else if (cmd == "nucleus") {
+      perf::run_nucleus(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");
