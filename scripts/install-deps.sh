@@ -5,6 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
+  clang-format           # the layout scripts/test.sh checks (.clang-format)
   libeigen3-dev          # linear algebra, eigen-solvers, CG
   libtbb-dev             # oneTBB: task graph, parallel_for
   libbullet-dev          # btDbvt broadphase, btSoftBody peer
