@@ -13,9 +13,9 @@ enum class ParticleKind : uint8_t { Free = 0, Anchored = 1, Scripted = 2 };
 
 struct Particles {
   SlotIndex slots;
-  std::vector<float> x, y, z;        // mm
-  std::vector<float> vx, vy, vz;     // mm/s
-  std::vector<float> inv_mass;       // 1/kg; 0 for anchored
+  std::vector<float> x, y, z;     // mm
+  std::vector<float> vx, vy, vz;  // mm/s
+  std::vector<float> inv_mass;    // 1/kg; 0 for anchored
   std::vector<ParticleKind> kind;
 
   template <class F>

@@ -23,8 +23,10 @@ size_t last_level_cache_bytes() {
     std::string s;
     if (!(in >> s) || s.empty()) continue;
     size_t mult = 1;
-    if (s.back() == 'K') mult = 1024, s.pop_back();
-    else if (s.back() == 'M') mult = 1024 * 1024, s.pop_back();
+    if (s.back() == 'K')
+      mult = 1024, s.pop_back();
+    else if (s.back() == 'M')
+      mult = 1024 * 1024, s.pop_back();
     try {
       best = std::max(best, static_cast<size_t>(std::stoull(s)) * mult);
     } catch (const std::exception&) {
@@ -33,9 +35,11 @@ size_t last_level_cache_bytes() {
   return best;
 }
 
-Bandwidth measure_bandwidth(const std::string& kernel, size_t array_bytes, int threads, int passes) {
+Bandwidth measure_bandwidth(const std::string& kernel, size_t array_bytes, int threads,
+                            int passes) {
   const bool triad = kernel == "triad";
-  if (!triad && kernel != "copy") throw std::invalid_argument("bandwidth kernel must be copy or triad");
+  if (!triad && kernel != "copy")
+    throw std::invalid_argument("bandwidth kernel must be copy or triad");
   const size_t n = std::max<size_t>(array_bytes / sizeof(double), 1024);
   // Uninitialised storage, so the first touch happens in the parallel loop below.
   std::unique_ptr<double[]> a(new double[n]), b(new double[n]), c(new double[n]);
@@ -45,9 +49,10 @@ Bandwidth measure_bandwidth(const std::string& kernel, size_t array_bytes, int t
   tbb::task_arena arena(threads);
   const auto run = [&](auto&& body) {
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16),
-                        [&](const tbb::blocked_range<size_t>& r) { body(r.begin(), r.end()); },
-                        tbb::static_partitioner());
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, n, 1 << 16),
+          [&](const tbb::blocked_range<size_t>& r) { body(r.begin(), r.end()); },
+          tbb::static_partitioner());
     });
   };
   run([&](size_t lo, size_t hi) {

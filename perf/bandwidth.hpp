@@ -13,10 +13,10 @@ namespace phaco::perf {
 size_t last_level_cache_bytes();
 
 struct Bandwidth {
-  std::string kernel;           // "copy" or "triad"
+  std::string kernel;  // "copy" or "triad"
   int threads = 1;
-  size_t array_bytes = 0;       // per array
-  double gb_per_s = 0;          // 1e9 bytes per second, best pass
+  size_t array_bytes = 0;  // per array
+  double gb_per_s = 0;     // 1e9 bytes per second, best pass
 };
 
 // Runs `passes` passes of the kernel on arrays of `array_bytes` each inside a oneTBB arena of

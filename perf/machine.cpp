@@ -20,8 +20,8 @@ Machine describe_machine() {
     }
   }
   m.logical_cores = static_cast<int>(std::thread::hardware_concurrency());
-  m.memory_gib = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE)) /
-                 (1024.0 * 1024.0 * 1024.0);
+  m.memory_gib = static_cast<double>(sysconf(_SC_PHYS_PAGES)) *
+                 static_cast<double>(sysconf(_SC_PAGE_SIZE)) / (1024.0 * 1024.0 * 1024.0);
 #if defined(__clang__)
   m.compiler = std::string("clang ") + __clang_version__;
 #elif defined(__GNUC__)
@@ -42,7 +42,8 @@ std::string machine_markdown(const Machine& m) {
   std::snprintf(buf, sizeof buf,
                 "| CPU | %s |\n| logical cores | %d |\n| memory | %.1f GiB |\n| compiler | %s |\n"
                 "| build | %s |\n| OS | %s |\n",
-                m.cpu.c_str(), m.logical_cores, m.memory_gib, m.compiler.c_str(), m.build.c_str(), m.os.c_str());
+                m.cpu.c_str(), m.logical_cores, m.memory_gib, m.compiler.c_str(), m.build.c_str(),
+                m.os.c_str());
   return std::string("| | |\n|---|---|\n") + buf;
 }
 

@@ -16,7 +16,9 @@ namespace {
 // Blocks of at least ~4096 particles: a block's springs then outweigh the task overhead, and a
 // mesh too small for two such blocks runs the spring pass serially (a mesh-size choice, never the
 // thread count, so results stay bit-identical across thread counts).
-uint32_t target_blocks(uint32_t particles) { return std::max<uint32_t>(1, particles / 4096); }
+uint32_t target_blocks(uint32_t particles) {
+  return std::max<uint32_t>(1, particles / 4096);
+}
 
 }  // namespace
 
@@ -28,7 +30,8 @@ MembraneFixture make_membrane_fixture(const FixtureOptions& o) {
   MembraneFixture m;
   m.options = o;
   const SurfaceMesh mesh =
-      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(o.level), eye::CapsuleLayout::Curvilinear);
+      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(o.level),
+                        eye::CapsuleLayout::Curvilinear);
   const uint32_t n = static_cast<uint32_t>(mesh.vertices.size());
   table_append(m.particles, n);
   for (uint32_t v = 0; v < n; ++v) {
@@ -82,7 +85,8 @@ MembraneFixture make_membrane_fixture(const FixtureOptions& o) {
   m.forces.resize_zero(n);
   double sum = 0;
   for (float r : m.springs.rest_length) sum += r;
-  m.mean_edge_mm = m.springs.slots.size() ? sum / m.springs.slots.size() / (1.0 - o.prestretch) : 0.0;
+  m.mean_edge_mm =
+      m.springs.slots.size() ? sum / m.springs.slots.size() / (1.0 - o.prestretch) : 0.0;
   m.max_k_over_m = springs::max_stiffness_over_mass(m.springs, m.particles);
   return m;
 }
@@ -91,7 +95,9 @@ double hot_bytes_per_vertex() {
   return 7 * sizeof(float) + sizeof(ParticleKind) + 3 * sizeof(float);  // 29 particle + 12 force
 }
 
-double hot_bytes_per_spring() { return 2 * sizeof(uint32_t) + 2 * sizeof(float); }
+double hot_bytes_per_spring() {
+  return 2 * sizeof(uint32_t) + 2 * sizeof(float);
+}
 
 double spring_pass_bytes(uint32_t vertices, uint32_t springs) {
   // Springs read once; positions read and forces read+written, each at least once per vertex.

@@ -22,7 +22,7 @@ struct FixtureOptions {
   double youngs_modulus_kpa = 2000;  // capsule, DESIGN.md §6
   double thickness_mm = 0.013;
   double density_kg_m3 = 1000;
-  double prestretch = 0.02;          // rest length = (1 − p)·mesh length
+  double prestretch = 0.02;  // rest length = (1 − p)·mesh length
   SpringLaw law = SpringLaw::Linear;
   StiffnessWeighting weighting = StiffnessWeighting::AreaWeighted;
 };
@@ -33,17 +33,18 @@ struct MembraneFixture {
   Triangles triangles;
   Springs springs;
   SpringBlocks blocks;
-  Forces forces;                  // zeroed
-  std::vector<uint32_t> rim;      // anchored particles, increasing
-  uint32_t centre = 0;            // the vertex on the optical axis (the loaded one)
-  double radius_mm = 0;           // projected rim radius
+  Forces forces;              // zeroed
+  std::vector<uint32_t> rim;  // anchored particles, increasing
+  uint32_t centre = 0;        // the vertex on the optical axis (the loaded one)
+  double radius_mm = 0;       // projected rim radius
   double mean_edge_mm = 0;
   double total_mass_kg = 0;
-  double max_k_over_m = 0;        // 1/s², from springs::max_stiffness_over_mass
+  double max_k_over_m = 0;  // 1/s², from springs::max_stiffness_over_mass
 
   uint32_t vertex_count() const { return particles.slots.size(); }
   uint32_t spring_count() const { return springs.slots.size(); }
-  // Largest stable symplectic-Euler step, 2/ω_max with ω_max² ≤ max Σk/m (Gershgorin), times `safety`.
+  // Largest stable symplectic-Euler step, 2/ω_max with ω_max² ≤ max Σk/m (Gershgorin), times
+  // `safety`.
   double stable_dt(double safety = 0.9) const;
 };
 
@@ -64,6 +65,7 @@ void integrate_nodes(Particles& particles, Forces& forces, float dt, float dampi
 
 // One plain SoA explicit step: external point force on `load_node` (if load != 0), spring pass,
 // node pass. Bit-identical for any thread count.
-void plain_step(MembraneFixture& m, float dt, float damping_per_s, uint32_t load_node, float load_z_mn);
+void plain_step(MembraneFixture& m, float dt, float damping_per_s, uint32_t load_node,
+                float load_z_mn);
 
 }  // namespace phaco::perf

@@ -38,12 +38,24 @@ struct DeformRunner {
     deform::Membrane m{f.particles, f.springs, f.blocks, f.forces, dynamics};
     m.loads = loads;
     switch (integrator) {
-      case Integrator::ExplicitEuler: deform::explicit_euler_step(m, dt); break;
-      case Integrator::SymplecticEuler: deform::symplectic_euler_step(m, dt); break;
-      case Integrator::SemiImplicit001: deform::semi_implicit_001_step(m, dt, axial); break;
-      case Integrator::ImplicitEuler: deform::implicit_euler_step(m, dt, implicit); break;
-      case Integrator::ImplicitPredictor: deform::implicit_predictor_step(m, dt, implicit); break;
-      case Integrator::Xpbd: deform::xpbd_step(m, dt, xpbd); break;
+      case Integrator::ExplicitEuler:
+        deform::explicit_euler_step(m, dt);
+        break;
+      case Integrator::SymplecticEuler:
+        deform::symplectic_euler_step(m, dt);
+        break;
+      case Integrator::SemiImplicit001:
+        deform::semi_implicit_001_step(m, dt, axial);
+        break;
+      case Integrator::ImplicitEuler:
+        deform::implicit_euler_step(m, dt, implicit);
+        break;
+      case Integrator::ImplicitPredictor:
+        deform::implicit_predictor_step(m, dt, implicit);
+        break;
+      case Integrator::Xpbd:
+        deform::xpbd_step(m, dt, xpbd);
+        break;
     }
   }
 };
@@ -89,7 +101,8 @@ void restore(MembraneFixture& f, const std::vector<float>& s) {
 
 }  // namespace
 
-std::vector<CostSample> measure_costs(MembraneFixture& f, int threads, double min_seconds, bool with_bullet) {
+std::vector<CostSample> measure_costs(MembraneFixture& f, int threads, double min_seconds,
+                                      bool with_bullet) {
   std::vector<CostSample> out;
   const std::vector<float> start = positions(f.particles);
   const double dt = f.stable_dt();
@@ -100,7 +113,8 @@ std::vector<CostSample> measure_costs(MembraneFixture& f, int threads, double mi
     t += dt_step;
     return static_cast<float>(-kLoadMn * std::sin(2 * M_PI * 50 * t));
   };
-  auto time = [&](const std::string& name, double step_dt, const std::string& note, const std::function<void()>& fn) {
+  auto time = [&](const std::string& name, double step_dt, const std::string& note,
+                  const std::function<void()>& fn) {
     restore(f, start);
     t = 0;
     out.push_back({name, seconds_per_call(threads, min_seconds, 3, fn), step_dt, note});
@@ -109,12 +123,10 @@ std::vector<CostSample> measure_costs(MembraneFixture& f, int threads, double mi
     springs::add_spring_forces(f.springs, f.blocks, f.options.law, f.particles, f.forces);
   });
   f.forces.resize_zero(f.vertex_count());
-  time("node pass", dt, "symplectic update + force reset", [&] {
-    integrate_nodes(f.particles, f.forces, static_cast<float>(dt), c);
-  });
-  time("plain step", dt, "spring pass + node pass, dt = 0.9 x stable", [&] {
-    plain_step(f, static_cast<float>(dt), c, f.centre, load_now(dt));
-  });
+  time("node pass", dt, "symplectic update + force reset",
+       [&] { integrate_nodes(f.particles, f.forces, static_cast<float>(dt), c); });
+  time("plain step", dt, "spring pass + node pass, dt = 0.9 x stable",
+       [&] { plain_step(f, static_cast<float>(dt), c, f.centre, load_now(dt)); });
 
   struct Plan {
     const char* name;
@@ -137,7 +149,8 @@ std::vector<CostSample> measure_costs(MembraneFixture& f, int threads, double mi
     runner->dynamics.law = f.options.law;
     runner->dynamics.viscosity_per_s = c;
     // Explicit Euler is unstable undamped at any dt; a drag above ω²·dt keeps it bounded.
-    if (plan.integrator == Integrator::ExplicitEuler) runner->dynamics.damping_per_s = 2.0f * float(f.max_k_over_m * plan.dt);
+    if (plan.integrator == Integrator::ExplicitEuler)
+      runner->dynamics.damping_per_s = 2.0f * float(f.max_k_over_m * plan.dt);
     runner->loads = {{f.centre, 0, 0, 0}};
     runner->xpbd.iterations = plan.xpbd_iterations ? plan.xpbd_iterations : runner->xpbd.iterations;
     const std::string note = plan.dt < 1e-3 ? "dt near the explicit limit" : "dt = 1/120 s";
@@ -151,11 +164,15 @@ std::vector<CostSample> measure_costs(MembraneFixture& f, int threads, double mi
     BulletMembraneOptions o;
     o.dt_s = kFrame;
     BulletMembrane bullet(f.particles, f.triangles, f.springs, o);
-    out.push_back({"btSoftBody", seconds_per_call(1, min_seconds, 3, [&] {
-                     bullet.add_force(f.centre, 0, 0, load_now(kFrame));
-                     bullet.step();
-                   }),
-                   kFrame, bullet.finite() ? "1 iteration, dt = 1/120 s" : "1 iteration, dt = 1/120 s: diverged"});
+    out.push_back(
+        {"btSoftBody",
+         seconds_per_call(1, min_seconds, 3,
+                          [&] {
+                            bullet.add_force(f.centre, 0, 0, load_now(kFrame));
+                            bullet.step();
+                          }),
+         kFrame,
+         bullet.finite() ? "1 iteration, dt = 1/120 s" : "1 iteration, dt = 1/120 s: diverged"});
   }
   restore(f, start);
   return out;
@@ -171,8 +188,9 @@ ActiveSample measure_active_grasp(MembraneFixture& f, int threads, double min_se
   double residual = 0;
   for (uint32_t v = 0; v < f.vertex_count(); ++v) {
     if (f.particles.kind[v] != ParticleKind::Free) continue;
-    residual = std::max<double>(residual, std::sqrt(f.forces.fx[v] * f.forces.fx[v] + f.forces.fy[v] * f.forces.fy[v] +
-                                                    f.forces.fz[v] * f.forces.fz[v]));
+    residual = std::max<double>(
+        residual, std::sqrt(f.forces.fx[v] * f.forces.fx[v] + f.forces.fy[v] * f.forces.fy[v] +
+                            f.forces.fz[v] * f.forces.fz[v]));
   }
   f.forces.resize_zero(f.vertex_count());
   const double force_threshold = std::max(1.0e-2, 2.0 * residual);
@@ -189,7 +207,8 @@ ActiveSample measure_active_grasp(MembraneFixture& f, int threads, double min_se
   ActiveSample sample;
   auto step = [&] {
     t += dt;
-    f.particles.z[grasp] = start[3 * grasp + 2] + static_cast<float>(0.05 * std::sin(2 * M_PI * 5 * t));
+    f.particles.z[grasp] =
+        start[3 * grasp + 2] + static_cast<float>(0.05 * std::sin(2 * M_PI * 5 * t));
     active_nodes::WakeInputs wake;
     wake.particles = &f.particles;
     wake.dt_s = dt;
@@ -197,7 +216,8 @@ ActiveSample measure_active_grasp(MembraneFixture& f, int threads, double min_se
     wake.law = f.options.law;
     wake.force_threshold_mn = force_threshold;
     active_nodes::update_active_set(graph, seeds, 5, wake, set);
-    for (uint32_t v : set.fell_asleep) f.particles.vx[v] = f.particles.vy[v] = f.particles.vz[v] = 0.0f;
+    for (uint32_t v : set.fell_asleep)
+      f.particles.vx[v] = f.particles.vy[v] = f.particles.vz[v] = 0.0f;
     deform::Membrane m{f.particles, f.springs, f.blocks, f.forces, dyn};
     m.active = set.particles;
     m.active_springs = set.springs;
@@ -216,7 +236,8 @@ ActiveSample measure_active_grasp(MembraneFixture& f, int threads, double min_se
     }
     // Clear the accumulator where the restricted pass wrote: active particles and spring ends.
     for (uint32_t e : set.springs) {
-      for (uint32_t v : {f.springs.i[e], f.springs.j[e]}) f.forces.fx[v] = f.forces.fy[v] = f.forces.fz[v] = 0.0f;
+      for (uint32_t v : {f.springs.i[e], f.springs.j[e]})
+        f.forces.fx[v] = f.forces.fy[v] = f.forces.fz[v] = 0.0f;
     }
   };
   sample.seconds_per_step = seconds_per_call(threads, min_seconds, 3, step);
@@ -245,7 +266,8 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
   for (uint32_t v = 0; v < f.vertex_count(); ++v) {
     for (int k = 0; k < 3; ++k) {
       u_ref[3 * v + k] = net.x[v][k] - rest[3 * v + k];
-      if (f.particles.kind[v] == ParticleKind::Free) ref_norm2 += u_ref[3 * v + k] * u_ref[3 * v + k];
+      if (f.particles.kind[v] == ParticleKind::Free)
+        ref_norm2 += u_ref[3 * v + k] * u_ref[3 * v + k];
     }
   }
   if (load_case) {
@@ -269,26 +291,33 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
     return std::sqrt(e2 / ref_norm2);
   };
   auto particle_error = [&] {
-    return error_of([&](uint32_t v, float* p) { p[0] = f.particles.x[v], p[1] = f.particles.y[v], p[2] = f.particles.z[v]; });
+    return error_of([&](uint32_t v, float* p) {
+      p[0] = f.particles.x[v], p[1] = f.particles.y[v], p[2] = f.particles.z[v];
+    });
   };
   std::vector<AccuracySample> out;
-  auto record = [&](const std::string& method, const std::string& setting, double wall, double err) {
+  auto record = [&](const std::string& method, const std::string& setting, double wall,
+                    double err) {
     const bool ok = std::isfinite(err) && err < 1e6;
     out.push_back({method, setting, wall, wall / kFrame, ok ? err : NAN, ok});
   };
 
   // Plain explicit step with mass scaling: heavier particles, a longer stable step.
-  for (double scale : quick ? std::vector<double>{1, 100, 1e4} : std::vector<double>{1, 10, 100, 1e3, 1e4, 1e5}) {
+  for (double scale :
+       quick ? std::vector<double>{1, 100, 1e4} : std::vector<double>{1, 10, 100, 1e3, 1e4, 1e5}) {
     restore(f, rest);
-    for (uint32_t v = 0; v < f.vertex_count(); ++v) f.particles.inv_mass[v] /= static_cast<float>(scale);
+    for (uint32_t v = 0; v < f.vertex_count(); ++v)
+      f.particles.inv_mass[v] /= static_cast<float>(scale);
     const double dt_stable = 0.9 * 2.0 / std::sqrt(f.max_k_over_m / scale);
     const int steps = static_cast<int>(std::ceil(kFrame / std::min(dt_stable, kFrame)));
     const float dt = static_cast<float>(kFrame / steps);
     const double wall = seconds_once(1, [&] {
       for (int s = 0; s < steps; ++s) plain_step(f, dt, c, f.centre, static_cast<float>(-kLoadMn));
     });
-    record("plain step", "mass x" + std::to_string(static_cast<long>(scale)), wall, particle_error());
-    for (uint32_t v = 0; v < f.vertex_count(); ++v) f.particles.inv_mass[v] *= static_cast<float>(scale);
+    record("plain step", "mass x" + std::to_string(static_cast<long>(scale)), wall,
+           particle_error());
+    for (uint32_t v = 0; v < f.vertex_count(); ++v)
+      f.particles.inv_mass[v] *= static_cast<float>(scale);
   }
 
   // Deform integrators at 1/120 s split into substeps.
@@ -299,11 +328,16 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
     uint16_t iterations;
   };
   const std::vector<Plan> plans = {
-      {"semi_implicit_001", Integrator::SemiImplicit001, quick ? std::vector<int>{1, 16} : std::vector<int>{1, 4, 16, 64, 256}, 0},
-      {"implicit_euler", Integrator::ImplicitEuler, quick ? std::vector<int>{1, 4} : std::vector<int>{1, 2, 4, 8, 16}, 0},
-      {"implicit_predictor", Integrator::ImplicitPredictor, quick ? std::vector<int>{1, 4} : std::vector<int>{1, 2, 4, 8, 16}, 0},
-      {"xpbd 8 it", Integrator::Xpbd, quick ? std::vector<int>{1, 4} : std::vector<int>{1, 4, 16, 64}, 8},
-      {"xpbd 64 it", Integrator::Xpbd, quick ? std::vector<int>{1} : std::vector<int>{1, 4, 16}, 64},
+      {"semi_implicit_001", Integrator::SemiImplicit001,
+       quick ? std::vector<int>{1, 16} : std::vector<int>{1, 4, 16, 64, 256}, 0},
+      {"implicit_euler", Integrator::ImplicitEuler,
+       quick ? std::vector<int>{1, 4} : std::vector<int>{1, 2, 4, 8, 16}, 0},
+      {"implicit_predictor", Integrator::ImplicitPredictor,
+       quick ? std::vector<int>{1, 4} : std::vector<int>{1, 2, 4, 8, 16}, 0},
+      {"xpbd 8 it", Integrator::Xpbd,
+       quick ? std::vector<int>{1, 4} : std::vector<int>{1, 4, 16, 64}, 8},
+      {"xpbd 64 it", Integrator::Xpbd, quick ? std::vector<int>{1} : std::vector<int>{1, 4, 16},
+       64},
   };
   for (const Plan& plan : plans) {
     for (int n : plan.substeps) {
@@ -339,7 +373,8 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
     const force_propagation::SourceForces forces{zero, zero, fz};
     const std::vector<std::pair<int, int>> settings =
         quick ? std::vector<std::pair<int, int>>{{8, 2}, {32, 16}}
-              : std::vector<std::pair<int, int>>{{4, 1}, {8, 2}, {16, 4}, {32, 16}, {64, 64}, {128, 256}};
+              : std::vector<std::pair<int, int>>{{4, 1},   {8, 2},   {16, 4},
+                                                 {32, 16}, {64, 64}, {128, 256}};
     for (const auto& [layers, sweeps] : settings) {
       restore(f, rest);
       force_propagation::PropagationSettings s;
@@ -347,9 +382,11 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
       s.sweeps = sweeps;
       s.tolerance_mm = 1e-9;
       const double wall = seconds_once(1, [&] {
-        force_propagation::propagate(f.particles, f.springs, f.options.law, graph, sources, s, scratch, &forces);
+        force_propagation::propagate(f.particles, f.springs, f.options.law, graph, sources, s,
+                                     scratch, &forces);
       });
-      record("force propagation", std::to_string(layers) + " layers x " + std::to_string(sweeps) + " sweeps", wall,
+      record("force propagation",
+             std::to_string(layers) + " layers x " + std::to_string(sweeps) + " sweeps", wall,
              particle_error());
     }
   }
@@ -368,9 +405,12 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
           bullet.step();
         }
       });
-      const double err = bullet.finite() ? error_of([&](uint32_t v, float* p) { bullet.position(v, p[0], p[1], p[2]); })
-                                         : NAN;
-      record("btSoftBody " + std::to_string(iterations) + " it", "dt 1/" + std::to_string(120 * n) + " s", wall, err);
+      const double err =
+          bullet.finite()
+              ? error_of([&](uint32_t v, float* p) { bullet.position(v, p[0], p[1], p[2]); })
+              : NAN;
+      record("btSoftBody " + std::to_string(iterations) + " it",
+             "dt 1/" + std::to_string(120 * n) + " s", wall, err);
     }
   }
   return out;
@@ -379,21 +419,24 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
 std::vector<StabilitySample> measure_stability(bool quick) {
   // deform::stability_map on its rim-anchored patch probe: k over several decades at the capsule's
   // level-3 node mass and 100 times it; only k/m matters for the undamped schemes.
-  const std::vector<double> k_values = quick ? std::vector<double>{0.01, 1, 100}
-                                             : std::vector<double>{1e-3, 1e-2, 0.1, 1, 10, 100, 1000};
+  const std::vector<double> k_values = quick
+                                           ? std::vector<double>{0.01, 1, 100}
+                                           : std::vector<double>{1e-3, 1e-2, 0.1, 1, 10, 100, 1000};
   const std::vector<double> masses = {1e-10, 1e-8};
   deform::StabilityProbe probe;
   if (quick) probe.bisections = 12;
   std::vector<StabilitySample> out;
-  for (Integrator integrator : {Integrator::ExplicitEuler, Integrator::SymplecticEuler, Integrator::SemiImplicit001,
-                                Integrator::ImplicitEuler, Integrator::ImplicitPredictor, Integrator::Xpbd}) {
+  for (Integrator integrator :
+       {Integrator::ExplicitEuler, Integrator::SymplecticEuler, Integrator::SemiImplicit001,
+        Integrator::ImplicitEuler, Integrator::ImplicitPredictor, Integrator::Xpbd}) {
     const deform::StabilityMap map = deform::stability_map(integrator, k_values, masses, probe);
     for (size_t ik = 0; ik < k_values.size(); ++ik) {
       for (size_t im = 0; im < masses.size(); ++im) {
         const deform::StabilityResult& r = map.cells[ik * masses.size() + im];
         const double k_over_m = k_values[ik] / masses[im];
         // Patch probe: omega_max ~ sqrt(8 k/m), so symplectic Euler's bound is 2/sqrt(8 k/m).
-        const double theory = integrator == Integrator::SymplecticEuler ? 2.0 / std::sqrt(8.0 * k_over_m) : 0.0;
+        const double theory =
+            integrator == Integrator::SymplecticEuler ? 2.0 / std::sqrt(8.0 * k_over_m) : 0.0;
         out.push_back({std::string(to_string(integrator)), k_over_m, r.dt_max_s, theory,
                        r.stable_everywhere, r.unstable_everywhere});
       }

@@ -20,13 +20,14 @@ namespace phaco::perf {
 struct CostSample {
   std::string method;
   double seconds_per_step = 0;
-  double dt_s = 0;        // the step the method was timed at
+  double dt_s = 0;  // the step the method was timed at
   std::string note;
 };
 
 // Methods timed per level: "spring pass", "node pass", "plain step" (ours), then every deform
 // integrator available, then "btSoftBody" (1 thread only; Bullet's solver is serial).
-std::vector<CostSample> measure_costs(MembraneFixture& m, int threads, double min_seconds, bool with_bullet);
+std::vector<CostSample> measure_costs(MembraneFixture& m, int threads, double min_seconds,
+                                      bool with_bullet);
 
 struct ActiveSample {
   uint32_t active_particles = 0, active_springs = 0;
@@ -37,19 +38,19 @@ ActiveSample measure_active_grasp(MembraneFixture& m, int threads, double min_se
 
 struct AccuracySample {
   std::string method;
-  std::string setting;           // "mass ×100", "dt 1/480 s", "16 layers × 4 sweeps", "10 iterations"
-  double wall_s_per_frame = 0;   // wall time for one 1/120 s frame
-  double cost_per_sim_s = 0;     // wall seconds per simulated second = 120 × wall_s_per_frame
-  double error = 0;              // ‖u − u_ref‖ / ‖u_ref‖ over free particles (u: displacement under the load)
+  std::string setting;  // "mass ×100", "dt 1/480 s", "16 layers × 4 sweeps", "10 iterations"
+  double wall_s_per_frame = 0;  // wall time for one 1/120 s frame
+  double cost_per_sim_s = 0;    // wall seconds per simulated second = 120 × wall_s_per_frame
+  double error = 0;  // ‖u − u_ref‖ / ‖u_ref‖ over free particles (u: displacement under the load)
   bool stable = true;
 };
 
 struct LoadCase {
-  double load_mn = 0;            // downward point force at the centre
-  double viscosity_per_s = 0;    // critical for the fundamental mode
+  double load_mn = 0;          // downward point force at the centre
+  double viscosity_per_s = 0;  // critical for the fundamental mode
   double frame_s = 1.0 / 120;
   double reference_centre_deflection_mm = 0;
-  double tension_mn_mm = 0;      // 1.5·E·h·p/(1 − p), equilateral-lattice estimate
+  double tension_mn_mm = 0;  // 1.5·E·h·p/(1 − p), equilateral-lattice estimate
 };
 
 // Builds the flat fixture at `level`, relaxes it in-plane to its static equilibrium, solves the
@@ -58,9 +59,9 @@ std::vector<AccuracySample> measure_accuracy(int level, bool quick, LoadCase* lo
 
 struct StabilitySample {
   std::string method;
-  double k_over_m = 0;       // 1/s², max over particles of Σk/m
-  double dt_max_s = 0;       // largest stable step (deform::largest_stable_dt)
-  double dt_theory_s = 0;    // 2/√(k/m)-type bound where one is known (0 otherwise)
+  double k_over_m = 0;               // 1/s², max over particles of Σk/m
+  double dt_max_s = 0;               // largest stable step (deform::largest_stable_dt)
+  double dt_theory_s = 0;            // 2/√(k/m)-type bound where one is known (0 otherwise)
   bool stable_everywhere = false;    // dt_max_s is the probe's upper bound
   bool unstable_everywhere = false;  // dt_max_s is 0
 };

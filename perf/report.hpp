@@ -28,10 +28,12 @@ void write_json(const Table& table, const std::filesystem::path& file);
 const std::vector<std::string>& study_order();
 
 // results_dir / (study + ".md").
-void write_section(const std::filesystem::path& results_dir, const std::string& study, const std::string& markdown);
+void write_section(const std::filesystem::path& results_dir, const std::string& study,
+                   const std::string& markdown);
 
 // The whole RESULTS.md text: header, machine table, then every section present in results_dir.
-std::string assemble_results(const std::filesystem::path& results_dir, const std::string& machine_markdown);
+std::string assemble_results(const std::filesystem::path& results_dir,
+                             const std::string& machine_markdown);
 
 // Progress bar on stderr: "[#####.....] 12/40 what".
 class Progress {

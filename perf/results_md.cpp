@@ -7,7 +7,8 @@
 namespace phaco::perf {
 
 void regenerate_results(const std::filesystem::path& out_dir) {
-  const std::string md = assemble_results(out_dir / "results", machine_markdown(describe_machine()));
+  const std::string md =
+      assemble_results(out_dir / "results", machine_markdown(describe_machine()));
   std::ofstream(out_dir / "RESULTS.md") << md;
 }
 

@@ -24,7 +24,8 @@ namespace fs = std::filesystem;
 struct LevelRow {
   int level = 0;
   size_t capsule_vertices = 0, capsule_triangles = 0, capsule_iso_vertices = 0, cornea_vertices = 0,
-         iris_vertices = 0, globe_vertices = 0, lens_surface_vertices = 0, lens_vertices = 0, lens_tets = 0;
+         iris_vertices = 0, globe_vertices = 0, lens_surface_vertices = 0, lens_vertices = 0,
+         lens_tets = 0;
   double surfaces_s = 0, tets_s = 0;
 };
 
@@ -47,7 +48,8 @@ LevelRow measure_level(int level) {
   const SurfaceMesh globe = eye::make_globe(params, res);
   const SurfaceMesh lens_surface = eye::make_lens_surface(params, res);
   row.surfaces_s = clock.elapsed_s();
-  row.capsule_iso_vertices = eye::make_capsule(params, res, eye::CapsuleLayout::Isotropic).vertices.size();
+  row.capsule_iso_vertices =
+      eye::make_capsule(params, res, eye::CapsuleLayout::Isotropic).vertices.size();
   clock.restart();
   const TetMesh lens = eye::make_lens_tets(params, res);
   row.tets_s = clock.elapsed_s();
@@ -70,7 +72,11 @@ SceneRow measure_scene(const Scenario& scenario, int threads, int repeats, const
     o.cache_dir = cache;
     const RunReport report = run_scenario(scenario, o);
     if (r == 0 || report.frame.p50_ms < best.frame_p50_ms) {
-      best = {threads, report.frames, report.frame.p50_ms, report.frame.p99_ms, report.frame.mean_ms,
+      best = {threads,
+              report.frames,
+              report.frame.p50_ms,
+              report.frame.p99_ms,
+              report.frame.mean_ms,
               report.state_hash};
     }
   }
@@ -89,7 +95,8 @@ void foundation(const StudyOptions& options) {
     };
     if (args[i] == "--max-level") {
       max_level = std::stoi(value());
-      if (max_level < eye::kMinLevel || max_level > eye::kMaxLevel) throw InputError("foundation: --max-level out of 0.." + std::to_string(eye::kMaxLevel));
+      if (max_level < eye::kMinLevel || max_level > eye::kMaxLevel)
+        throw InputError("foundation: --max-level out of 0.." + std::to_string(eye::kMaxLevel));
     } else if (args[i] == "--frames-repeat") {
       repeats = std::max(1, std::stoi(value()));
     } else if (args[i] == "--scenario") {
@@ -116,61 +123,79 @@ void foundation(const StudyOptions& options) {
   progress.finish();
 
   Table lt;
-  lt.columns = {"level", "capsule_vertices", "capsule_triangles", "capsule_isotropic_vertices", "cornea_vertices",
-                "iris_vertices", "globe_vertices", "lens_surface_vertices", "lens_vertices", "lens_tets",
-                "surfaces_s", "tets_s"};
+  lt.columns = {
+      "level",           "capsule_vertices", "capsule_triangles", "capsule_isotropic_vertices",
+      "cornea_vertices", "iris_vertices",    "globe_vertices",    "lens_surface_vertices",
+      "lens_vertices",   "lens_tets",        "surfaces_s",        "tets_s"};
   for (const auto& r : levels) {
-    lt.add({double(r.level), double(r.capsule_vertices), double(r.capsule_triangles), double(r.capsule_iso_vertices),
-            double(r.cornea_vertices), double(r.iris_vertices), double(r.globe_vertices),
-            double(r.lens_surface_vertices), double(r.lens_vertices), double(r.lens_tets), r.surfaces_s, r.tets_s});
+    lt.add({double(r.level), double(r.capsule_vertices), double(r.capsule_triangles),
+            double(r.capsule_iso_vertices), double(r.cornea_vertices), double(r.iris_vertices),
+            double(r.globe_vertices), double(r.lens_surface_vertices), double(r.lens_vertices),
+            double(r.lens_tets), r.surfaces_s, r.tets_s});
   }
   write_csv(lt, out_dir / "results" / "foundation.csv");
   write_json(lt, out_dir / "results" / "foundation.json");
   Table st;
   st.columns = {"threads", "frames", "frame_p50_ms", "frame_p99_ms", "frame_mean_ms", "state_hash"};
   for (const auto& s : scenes) {
-    st.add({double(s.threads), double(s.frames), s.frame_p50_ms, s.frame_p99_ms, s.mean_ms, s.hash});
+    st.add(
+        {double(s.threads), double(s.frames), s.frame_p50_ms, s.frame_p99_ms, s.mean_ms, s.hash});
   }
   write_csv(st, out_dir / "results" / "foundation_empty_scene.csv");
   write_json(st, out_dir / "results" / "foundation_empty_scene.json");
 
   std::string md;
   md += "## Eye meshes per resolution level\n\n";
-  md += std::string("Measured by `phaco-perf foundation") + (options.quick ? " --quick" : "") + "`.\n\n";
-  md += "Standard eye (data/eye/standard_eye.json). Capsule: curvilinear rings-and-spokes layout (isotropic variant "
-        "count beside it). Lens tets by TetGen with quality bounds. Generation is single-threaded; meshes are cached "
-        "on disk after the first build, so a scene loads them in a fraction of these times.\n\n";
-  md += "| level | capsule vertices | capsule triangles | isotropic capsule vertices | cornea vertices | iris vertices | "
-        "globe vertices | lens surface vertices | lens vertices | lens tets | surfaces (s) | tets (s) |\n";
+  md += std::string("Measured by `phaco-perf foundation") + (options.quick ? " --quick" : "") +
+        "`.\n\n";
+  md +=
+      "Standard eye (data/eye/standard_eye.json). Capsule: curvilinear rings-and-spokes layout "
+      "(isotropic variant "
+      "count beside it). Lens tets by TetGen with quality bounds. Generation is single-threaded; "
+      "meshes are cached "
+      "on disk after the first build, so a scene loads them in a fraction of these times.\n\n";
+  md +=
+      "| level | capsule vertices | capsule triangles | isotropic capsule vertices | cornea "
+      "vertices | iris vertices | "
+      "globe vertices | lens surface vertices | lens vertices | lens tets | surfaces (s) | tets "
+      "(s) |\n";
   md += "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& r : levels) {
     md += "| " + std::to_string(r.level) + " | " + std::to_string(r.capsule_vertices) + " | " +
-          std::to_string(r.capsule_triangles) + " | " + std::to_string(r.capsule_iso_vertices) + " | " +
-          std::to_string(r.cornea_vertices) + " | " + std::to_string(r.iris_vertices) + " | " +
-          std::to_string(r.globe_vertices) + " | " + std::to_string(r.lens_surface_vertices) + " | " +
-          std::to_string(r.lens_vertices) + " | " + std::to_string(r.lens_tets) + " | " + fmt("%.3f", r.surfaces_s) +
-          " | " + fmt("%.2f", r.tets_s) + " |\n";
+          std::to_string(r.capsule_triangles) + " | " + std::to_string(r.capsule_iso_vertices) +
+          " | " + std::to_string(r.cornea_vertices) + " | " + std::to_string(r.iris_vertices) +
+          " | " + std::to_string(r.globe_vertices) + " | " +
+          std::to_string(r.lens_surface_vertices) + " | " + std::to_string(r.lens_vertices) +
+          " | " + std::to_string(r.lens_tets) + " | " + fmt("%.3f", r.surfaces_s) + " | " +
+          fmt("%.2f", r.tets_s) + " |\n";
   }
   md += "\n## Frame cost of the empty scene\n\n";
   md += "`" + fs::relative(scenario_file, PHACO_SOURCE_DIR).string() + "`: drill `" +
         std::string(to_string(scenario.drill)) + "`, level " + std::to_string(scenario.eye.level) +
-        ", the bodies loaded but no physics systems yet (tools follow their tracks; the topology sync point applies "
-        "an empty command queue). This is the scheduler's own overhead per frame: the floor under every later "
-        "figure. Best p50 of " + std::to_string(repeats) + " runs.\n\n";
+        ", the bodies loaded but no physics systems yet (tools follow their tracks; the topology "
+        "sync point applies "
+        "an empty command queue). This is the scheduler's own overhead per frame: the floor under "
+        "every later "
+        "figure. Best p50 of " +
+        std::to_string(repeats) + " runs.\n\n";
   md += "| threads | frames | frame p50 (µs) | frame p99 (µs) | frame mean (µs) | state hash |\n";
   md += "|---:|---:|---:|---:|---:|---|\n";
   for (const auto& s : scenes) {
-    md += "| " + std::to_string(s.threads) + " | " + std::to_string(s.frames) + " | " + fmt("%.2f", 1e3 * s.frame_p50_ms) +
-          " | " + fmt("%.2f", 1e3 * s.frame_p99_ms) + " | " + fmt("%.2f", 1e3 * s.mean_ms) + " | `" + s.hash + "` |\n";
+    md += "| " + std::to_string(s.threads) + " | " + std::to_string(s.frames) + " | " +
+          fmt("%.2f", 1e3 * s.frame_p50_ms) + " | " + fmt("%.2f", 1e3 * s.frame_p99_ms) + " | " +
+          fmt("%.2f", 1e3 * s.mean_ms) + " | `" + s.hash + "` |\n";
   }
   const bool same = scenes.size() == 2 && scenes[0].hash == scenes[1].hash;
-  md += same ? "\nThe state hash is equal for 1 and 2 threads: the run is bit-identical whatever the thread count.\n"
+  md += same ? "\nThe state hash is equal for 1 and 2 threads: the run is bit-identical whatever "
+               "the thread count.\n"
              : "\n**The state hashes differ between 1 and 2 threads: determinism is broken.**\n";
   write_section(out_dir / "results", "foundation", md);
 }
 
 }  // namespace
 
-void run_foundation(const StudyOptions& options) { foundation(options); }
+void run_foundation(const StudyOptions& options) {
+  foundation(options);
+}
 
 }  // namespace phaco::perf

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
-#include "perf/plot.hpp"
 #include "perf/haptics/loop_measure.hpp"
 #include "perf/haptics/scene_haptics_measure.hpp"
 #include "perf/haptics/stability_measure.hpp"
+#include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
 

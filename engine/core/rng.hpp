@@ -31,7 +31,8 @@ class CounterRng {
  public:
   // `stream` separates independent uses (e.g. erosion vs. tear jitter) under one scenario seed.
   constexpr explicit CounterRng(uint64_t seed, uint32_t stream = 0)
-      : key_{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32) ^ (stream * 0x9E3779B9u)},
+      : key_{static_cast<uint32_t>(seed),
+             static_cast<uint32_t>(seed >> 32) ^ (stream * 0x9E3779B9u)},
         stream_(stream) {}
 
   constexpr PhiloxCounter bits(uint64_t frame, uint32_t element, uint32_t draw = 0) const {

@@ -27,15 +27,11 @@ class StateHash {
     length_ += n;
   }
   template <class T>
-    requires std::is_trivially_copyable_v<T>
-  void add(std::span<const T> values) {
-    add_bytes(values.data(), values.size_bytes());
-  }
+  requires std::is_trivially_copyable_v<T>
+  void add(std::span<const T> values) { add_bytes(values.data(), values.size_bytes()); }
   template <class T>
-    requires std::is_trivially_copyable_v<T>
-  void add_value(const T& v) {
-    add_bytes(&v, sizeof(T));
-  }
+  requires std::is_trivially_copyable_v<T>
+  void add_value(const T& v) { add_bytes(&v, sizeof(T)); }
   void add_string(std::string_view s) { add_bytes(s.data(), s.size()); }
 
   uint64_t value() const { return finalize(state_ ^ length_); }

@@ -71,7 +71,8 @@ class CommandBuffer {
 // One buffer per worker slot, so recording from parallel_for needs no lock.
 class CommandQueues {
  public:
-  explicit CommandQueues(int workers = 1) : buffers_(static_cast<size_t>(workers < 1 ? 1 : workers)) {}
+  explicit CommandQueues(int workers = 1)
+      : buffers_(static_cast<size_t>(workers < 1 ? 1 : workers)) {}
   CommandBuffer& for_worker(int worker) { return buffers_.at(static_cast<size_t>(worker)); }
   int workers() const { return static_cast<int>(buffers_.size()); }
   size_t pending() const;

@@ -80,7 +80,9 @@ class HapticLoop {
   // Any thread, also while running (approximate then; see loop_stats.hpp).
   LoopStatsSnapshot stats() const { return stats_.snapshot(); }
   // The period's histogram bins (charts of the period under load).
-  std::vector<DurationHistogram::Bin> period_bins() const { return stats_.period().occupied_bins(); }
+  std::vector<DurationHistogram::Bin> period_bins() const {
+    return stats_.period().occupied_bins();
+  }
 
  private:
   void run();

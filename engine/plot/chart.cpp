@@ -4,10 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
-#include <stdexcept>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 namespace phaco::plot {
 
@@ -18,13 +17,15 @@ constexpr int kLeft = 100, kTop = 56, kBottom = 70, kLegendWidth = 270;
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 const cv::Scalar kPalette[] = {
-    {180, 119, 31},  {14, 127, 255}, {44, 160, 44},  {40, 39, 214},   {189, 103, 148},
-    {75, 86, 140},   {194, 119, 227}, {127, 127, 127}, {34, 189, 188}, {207, 190, 23},
+    {180, 119, 31}, {14, 127, 255},  {44, 160, 44},   {40, 39, 214},  {189, 103, 148},
+    {75, 86, 140},  {194, 119, 227}, {127, 127, 127}, {34, 189, 188}, {207, 190, 23},
 };
 constexpr size_t kPaletteSize = sizeof(kPalette) / sizeof(kPalette[0]);
 const cv::Scalar kInk(40, 40, 40), kGrid(225, 225, 225), kWhite(255, 255, 255);
 
-bool finite(double v) { return std::isfinite(v); }
+bool finite(double v) {
+  return std::isfinite(v);
+}
 
 std::string tick_label(double v) {
   char buf[32];
@@ -33,8 +34,10 @@ std::string tick_label(double v) {
   if (a >= 1e5 || a < 1e-3) {
     const int e = static_cast<int>(std::floor(std::log10(a) + 1e-9));
     const double m = v / std::pow(10.0, e);
-    if (std::fabs(m - std::round(m)) < 1e-6) std::snprintf(buf, sizeof buf, "%.0fe%d", m, e);
-    else std::snprintf(buf, sizeof buf, "%.1fe%d", m, e);
+    if (std::fabs(m - std::round(m)) < 1e-6)
+      std::snprintf(buf, sizeof buf, "%.0fe%d", m, e);
+    else
+      std::snprintf(buf, sizeof buf, "%.1fe%d", m, e);
   } else {
     std::snprintf(buf, sizeof buf, "%g", v);
   }
@@ -54,10 +57,15 @@ double nice_step(double span, int target) {
 void draw_marker(cv::Mat& img, cv::Point p, size_t shape, const cv::Scalar& c) {
   constexpr int r = 4;
   switch (shape % 4) {
-    case 0: cv::circle(img, p, r, c, cv::FILLED, cv::LINE_AA); break;
-    case 1: cv::rectangle(img, p - cv::Point(r, r), p + cv::Point(r, r), c, cv::FILLED); break;
+    case 0:
+      cv::circle(img, p, r, c, cv::FILLED, cv::LINE_AA);
+      break;
+    case 1:
+      cv::rectangle(img, p - cv::Point(r, r), p + cv::Point(r, r), c, cv::FILLED);
+      break;
     case 2: {
-      const cv::Point tri[3] = {p + cv::Point(0, -r - 1), p + cv::Point(r + 1, r), p + cv::Point(-r - 1, r)};
+      const cv::Point tri[3] = {p + cv::Point(0, -r - 1), p + cv::Point(r + 1, r),
+                                p + cv::Point(-r - 1, r)};
       cv::fillConvexPoly(img, tri, 3, c, cv::LINE_AA);
       break;
     }
@@ -72,12 +80,14 @@ void dashed_line(cv::Mat& img, cv::Point2d a, cv::Point2d b, const cv::Scalar& c
   if (len < 1) return;
   const int n = std::max(1, static_cast<int>(len / 8));
   for (int k = 0; k < n; k += 2) {
-    const double t0 = static_cast<double>(k) / n, t1 = std::min(1.0, static_cast<double>(k + 1) / n);
+    const double t0 = static_cast<double>(k) / n,
+                 t1 = std::min(1.0, static_cast<double>(k + 1) / n);
     cv::line(img, a + (b - a) * t0, a + (b - a) * t1, c, thickness, cv::LINE_AA);
   }
 }
 
-void text(cv::Mat& img, const std::string& s, cv::Point at, double scale, const cv::Scalar& c, int thick = 1) {
+void text(cv::Mat& img, const std::string& s, cv::Point at, double scale, const cv::Scalar& c,
+          int thick = 1) {
   cv::putText(img, s, at, kFont, scale, c, thick, cv::LINE_AA);
 }
 
@@ -116,15 +126,19 @@ PowerFit fit_power_law(std::span<const double> x, std::span<const double> y) {
   return fit;
 }
 
-bool AxisMap::usable(double v) const { return finite(v) && (scale == Scale::Linear || v > 0); }
+bool AxisMap::usable(double v) const {
+  return finite(v) && (scale == Scale::Linear || v > 0);
+}
 
 double AxisMap::to_pixel(double v) const {
-  const double t = scale == Scale::Log10 ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
-                                         : (v - lo) / (hi - lo);
+  const double t = scale == Scale::Log10
+                       ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
+                       : (v - lo) / (hi - lo);
   return p0 + t * (p1 - p0);
 }
 
-std::optional<std::pair<double, double>> axis_range(const Axis& axis, std::span<const double> values) {
+std::optional<std::pair<double, double>> axis_range(const Axis& axis,
+                                                    std::span<const double> values) {
   const bool log = axis.scale == Scale::Log10;
   double lo = INFINITY, hi = -INFINITY;
   for (double v : values) {
@@ -203,12 +217,17 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
 
   // Gather usable values per axis to size the ranges.
   std::vector<double> xs, ys;
-  const auto usable_x = [&](double v) { return finite(v) && (chart.x.scale == Scale::Linear || v > 0); };
-  const auto usable_y = [&](double v) { return finite(v) && (chart.y.scale == Scale::Linear || v > 0); };
+  const auto usable_x = [&](double v) {
+    return finite(v) && (chart.x.scale == Scale::Linear || v > 0);
+  };
+  const auto usable_y = [&](double v) {
+    return finite(v) && (chart.y.scale == Scale::Linear || v > 0);
+  };
   for (const Series& s : chart.series) {
     const size_t n = std::min(s.x.size(), s.y.size());
     if (s.x.size() != s.y.size()) {
-      report.warnings.push_back("series '" + s.name + "': x and y lengths differ, extra points ignored");
+      report.warnings.push_back("series '" + s.name +
+                                "': x and y lengths differ, extra points ignored");
     }
     size_t skipped = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -219,15 +238,18 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
       }
     }
     report.points_skipped += skipped;
-    if (n == 0) report.warnings.push_back("series '" + s.name + "' is empty");
+    if (n == 0)
+      report.warnings.push_back("series '" + s.name + "' is empty");
     else if (skipped) {
       report.warnings.push_back("series '" + s.name + "': " + std::to_string(skipped) +
                                 " point(s) skipped (NaN, infinite, or not positive on a log axis)");
     }
   }
   for (const Marker& m : chart.markers) {
-    if (usable_x(m.x) && usable_y(m.y)) xs.push_back(m.x), ys.push_back(m.y);
-    else report.warnings.push_back("marker '" + m.label + "' skipped (not drawable on these axes)");
+    if (usable_x(m.x) && usable_y(m.y))
+      xs.push_back(m.x), ys.push_back(m.y);
+    else
+      report.warnings.push_back("marker '" + m.label + "' skipped (not drawable on these axes)");
   }
 
   // Title and axis labels.
@@ -253,9 +275,13 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
     if (report_out) *report_out = report;
     return img;
   }
-  const AxisMap mx{xr->first, xr->second, chart.x.scale, static_cast<double>(px0), static_cast<double>(px1)};
-  const AxisMap my{yr->first, yr->second, chart.y.scale, static_cast<double>(py0), static_cast<double>(py1)};
-  const auto in_box = [&](double px, double py) { return px >= px0 - 1 && px <= px1 + 1 && py >= py1 - 1 && py <= py0 + 1; };
+  const AxisMap mx{xr->first, xr->second, chart.x.scale, static_cast<double>(px0),
+                   static_cast<double>(px1)};
+  const AxisMap my{yr->first, yr->second, chart.y.scale, static_cast<double>(py0),
+                   static_cast<double>(py1)};
+  const auto in_box = [&](double px, double py) {
+    return px >= px0 - 1 && px <= px1 + 1 && py >= py1 - 1 && py <= py0 + 1;
+  };
 
   // Grid and tick labels.
   for (double t : axis_ticks(mx.lo, mx.hi, mx.scale)) {
@@ -297,11 +323,14 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
   // Series.
   int legend_y = kTop + 12;
   const int lx = px1 + 18;
-  auto legend_entry = [&](const std::string& label, const cv::Scalar& c, size_t shape, bool line, bool dashed) {
+  auto legend_entry = [&](const std::string& label, const cv::Scalar& c, size_t shape, bool line,
+                          bool dashed) {
     if (legend_y > h - 20) return;
     if (line) {
-      if (dashed) dashed_line(img, {double(lx), double(legend_y)}, {double(lx + 28), double(legend_y)}, c, 2);
-      else cv::line(img, {lx, legend_y}, {lx + 28, legend_y}, c, 2, cv::LINE_AA);
+      if (dashed)
+        dashed_line(img, {double(lx), double(legend_y)}, {double(lx + 28), double(legend_y)}, c, 2);
+      else
+        cv::line(img, {lx, legend_y}, {lx + 28, legend_y}, c, 2, cv::LINE_AA);
     }
     if (shape != size_t(-1)) draw_marker(img, {lx + 14, legend_y}, shape, c);
     text(img, fit_text(label, 0.45, kLegendWidth - 50), {lx + 36, legend_y + 5}, 0.45, kInk);
@@ -328,8 +357,10 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
     const bool marks = s.style != Style::Line;
     if (lines) {
       for (size_t k = 0; k + 1 < pts.size(); ++k) {
-        if (s.dashed) dashed_line(img, pts[k], pts[k + 1], c, 2);
-        else cv::line(img, pts[k], pts[k + 1], c, 2, cv::LINE_AA);
+        if (s.dashed)
+          dashed_line(img, pts[k], pts[k + 1], c, 2);
+        else
+          cv::line(img, pts[k], pts[k + 1], c, 2, cv::LINE_AA);
       }
     }
     if (marks) {
@@ -343,11 +374,13 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
         const double ya = fit.coefficient * std::pow(*xmin, fit.slope);
         const double yb = fit.coefficient * std::pow(*xmax, fit.slope);
         if (my.usable(ya) && my.usable(yb)) {
-          const cv::Point2d a(mx.to_pixel(*xmin), my.to_pixel(ya)), b(mx.to_pixel(*xmax), my.to_pixel(yb));
+          const cv::Point2d a(mx.to_pixel(*xmin), my.to_pixel(ya)),
+              b(mx.to_pixel(*xmax), my.to_pixel(yb));
           dashed_line(img, a, b, cv::Scalar(60, 60, 60), 1);
           char buf[32];
           std::snprintf(buf, sizeof buf, "slope %.2f", fit.slope);
-          const cv::Point at(static_cast<int>(std::min(b.x - text_width(buf, 0.45), px1 - 4.0 - text_width(buf, 0.45))),
+          const cv::Point at(static_cast<int>(std::min(b.x - text_width(buf, 0.45),
+                                                       px1 - 4.0 - text_width(buf, 0.45))),
                              static_cast<int>(std::clamp(b.y - 8, py1 + 14.0, py0 - 4.0)));
           text(img, buf, at, 0.45, c, 1);
           label += std::string(" (") + buf + ")";
@@ -380,7 +413,8 @@ RenderReport save_chart(const Chart& chart, const std::filesystem::path& png) {
   RenderReport report;
   const cv::Mat img = render_chart(chart, &report);
   if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());
-  if (!cv::imwrite(png.string(), img)) throw std::runtime_error("cannot write chart " + png.string());
+  if (!cv::imwrite(png.string(), img))
+    throw std::runtime_error("cannot write chart " + png.string());
   return report;
 }
 

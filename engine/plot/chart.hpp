@@ -12,12 +12,11 @@
 // OpenCV's Hershey fonts are ASCII only: write "us", not "µs".
 #include <cstddef>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace phaco::plot {
 
@@ -50,16 +49,17 @@ struct Chart {
   Axis x, y;
   std::vector<Series> series;
   std::vector<Marker> markers;
-  bool pareto_front = false;  // join the points no other point beats on both x and y (both minimised)
+  bool pareto_front =
+      false;  // join the points no other point beats on both x and y (both minimised)
   int width = 960, height = 640;
 };
 
 struct PowerFit {
-  bool ok = false;      // at least two usable points with distinct x
-  double slope = 0;     // s in y = c·x^s
+  bool ok = false;         // at least two usable points with distinct x
+  double slope = 0;        // s in y = c·x^s
   double coefficient = 0;  // c
-  double r2 = 0;        // on log-log
-  size_t points = 0;    // usable points (finite, positive)
+  double r2 = 0;           // on log-log
+  size_t points = 0;       // usable points (finite, positive)
 };
 
 // Least squares on (log x, log y); skips non-finite and non-positive points.
@@ -71,14 +71,15 @@ struct AxisMap {
   Scale scale = Scale::Linear;
   double p0 = 0, p1 = 1;
 
-  bool usable(double v) const;    // finite, and > 0 on a log axis
+  bool usable(double v) const;      // finite, and > 0 on a log axis
   double to_pixel(double v) const;  // callers check usable() first
 };
 
 // Data range of an axis from the values (ignoring unusable ones) and the axis's fixed bounds: a log
 // axis is widened to whole decades, a linear one to "nice" 1-2-5 steps. Returns nullopt when no
 // value is usable and no bounds are fixed.
-std::optional<std::pair<double, double>> axis_range(const Axis& axis, std::span<const double> values);
+std::optional<std::pair<double, double>> axis_range(const Axis& axis,
+                                                    std::span<const double> values);
 
 // Tick positions inside [lo, hi]: every decade on a log axis (with 2 and 5 when it spans under two
 // decades), 1-2-5 steps on a linear one.

@@ -3,7 +3,6 @@
 // vertices, 1 and 2 threads. Counters: ns per vertex per step and bytes moved per second.
 //   build/release/perf/bench_membrane --benchmark_min_time=0.2
 #include <benchmark/benchmark.h>
-
 #include <oneapi/tbb/task_arena.h>
 
 #include <map>
@@ -36,9 +35,10 @@ void run(benchmark::State& state, double bytes_per_call, Fn&& fn) {
   });
   const double n = static_cast<double>(state.iterations());
   state.counters["vertices"] = m.vertex_count();
-  state.counters["ns_per_vertex"] =
-      benchmark::Counter(n * m.vertex_count() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["bytes_per_s"] = benchmark::Counter(n * bytes_per_call, benchmark::Counter::kIsRate);
+  state.counters["ns_per_vertex"] = benchmark::Counter(
+      n * m.vertex_count() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["bytes_per_s"] =
+      benchmark::Counter(n * bytes_per_call, benchmark::Counter::kIsRate);
 }
 
 void BM_SpringPass(benchmark::State& state) {
@@ -52,7 +52,9 @@ void BM_SpringPass(benchmark::State& state) {
 void BM_NodePass(benchmark::State& state) {
   MembraneFixture& f = fixture(static_cast<int>(state.range(0)));
   const float dt = static_cast<float>(f.stable_dt());
-  run(state, plain_step_bytes(f.vertex_count(), f.spring_count()) - spring_pass_bytes(f.vertex_count(), f.spring_count()),
+  run(state,
+      plain_step_bytes(f.vertex_count(), f.spring_count()) -
+          spring_pass_bytes(f.vertex_count(), f.spring_count()),
       [dt](MembraneFixture& m) { integrate_nodes(m.particles, m.forces, dt, 1000.0f); });
 }
 
@@ -63,9 +65,18 @@ void BM_PlainStep(benchmark::State& state) {
       [dt](MembraneFixture& m) { plain_step(m, dt, 1000.0f, m.centre, -0.01f); });
 }
 
-BENCHMARK(BM_SpringPass)->ArgsProduct({{3, 7}, {1, 2}})->ArgNames({"level", "threads"})->UseRealTime();
-BENCHMARK(BM_NodePass)->ArgsProduct({{3, 7}, {1, 2}})->ArgNames({"level", "threads"})->UseRealTime();
-BENCHMARK(BM_PlainStep)->ArgsProduct({{3, 7}, {1, 2}})->ArgNames({"level", "threads"})->UseRealTime();
+BENCHMARK(BM_SpringPass)
+    ->ArgsProduct({{3, 7}, {1, 2}})
+    ->ArgNames({"level", "threads"})
+    ->UseRealTime();
+BENCHMARK(BM_NodePass)
+    ->ArgsProduct({{3, 7}, {1, 2}})
+    ->ArgNames({"level", "threads"})
+    ->UseRealTime();
+BENCHMARK(BM_PlainStep)
+    ->ArgsProduct({{3, 7}, {1, 2}})
+    ->ArgNames({"level", "threads"})
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace phaco::perf

@@ -65,7 +65,8 @@ BulletMembrane::BulletMembrane(const Particles& p, const Triangles& tris, const 
     m.body->appendLink(static_cast<int>(s.i[e]), static_cast<int>(s.j[e]), mat, false);
   }
   for (uint32_t t = 0; t < tris.slots.size(); ++t) {
-    m.body->appendFace(static_cast<int>(tris.a[t]), static_cast<int>(tris.b[t]), static_cast<int>(tris.c[t]), mat);
+    m.body->appendFace(static_cast<int>(tris.a[t]), static_cast<int>(tris.b[t]),
+                       static_cast<int>(tris.c[t]), mat);
   }
   m.body->m_cfg.piterations = std::max(1, o.position_iterations);
   m.body->m_cfg.kDP = static_cast<btScalar>(o.damping);
@@ -96,11 +97,18 @@ void BulletMembrane::add_force(uint32_t node, float fx, float fy, float fz) {
   impl_->body->addForce(btVector3(fx, fy, fz), static_cast<int>(node));
 }
 
-void BulletMembrane::step() { impl_->world.stepSimulation(static_cast<btScalar>(impl_->dt), 0, static_cast<btScalar>(impl_->dt)); }
+void BulletMembrane::step() {
+  impl_->world.stepSimulation(static_cast<btScalar>(impl_->dt), 0,
+                              static_cast<btScalar>(impl_->dt));
+}
 
-uint32_t BulletMembrane::node_count() const { return static_cast<uint32_t>(impl_->body->m_nodes.size()); }
+uint32_t BulletMembrane::node_count() const {
+  return static_cast<uint32_t>(impl_->body->m_nodes.size());
+}
 
-float BulletMembrane::link_stiffness() const { return impl_->klst; }
+float BulletMembrane::link_stiffness() const {
+  return impl_->klst;
+}
 
 void BulletMembrane::position(uint32_t node, float& x, float& y, float& z) const {
   const btVector3& v = impl_->body->m_nodes[static_cast<int>(node)].m_x;

@@ -25,7 +25,7 @@ namespace phaco::perf {
 struct BulletMembraneOptions {
   double dt_s = 1.0 / 120;
   int position_iterations = 1;  // btSoftBody::Config::piterations (Bullet's default 1)
-  double damping = 0.0;         // btSoftBody::Config::kDP ∈ [0, 1], velocity fraction removed per step
+  double damping = 0.0;  // btSoftBody::Config::kDP ∈ [0, 1], velocity fraction removed per step
 };
 
 class BulletMembrane {

@@ -81,7 +81,8 @@ double nucleus_posterior_z(const NucleusShape& n, double x, double y) {
 TrenchReport measure_trenches(std::span<const RemovedElement> removed, const NucleusShape& nucleus,
                               const TrenchSettings& settings) {
   if (!(nucleus.equatorial_radius_mm > 0 && nucleus.anterior_mm > 0 && nucleus.posterior_mm < 0)) {
-    throw std::invalid_argument("measure_trenches: nucleus radius and anterior pole must be > 0, posterior pole < 0");
+    throw std::invalid_argument(
+        "measure_trenches: nucleus radius and anterior pole must be > 0, posterior pole < 0");
   }
   TrenchReport report;
   std::map<uint32_t, std::vector<const RemovedElement*>> by_stroke;
@@ -103,8 +104,8 @@ TrenchReport measure_trenches(std::span<const RemovedElement> removed, const Nuc
   for (uint32_t i = 0; i < axes.size(); ++i) {
     for (uint32_t j = i + 1; j < axes.size(); ++j) {
       if (angle_between_deg(axes[i].dir, axes[j].dir) > settings.same_direction_deg) continue;
-      if (std::min(distance_to_line(axes[i].centre, axes[j]), distance_to_line(axes[j].centre, axes[i])) >
-          settings.same_line_mm)
+      if (std::min(distance_to_line(axes[i].centre, axes[j]),
+                   distance_to_line(axes[j].centre, axes[i])) > settings.same_line_mm)
         continue;
       parent[find(parent, j)] = find(parent, i);
     }
@@ -150,7 +151,8 @@ TrenchReport measure_trenches(std::span<const RemovedElement> removed, const Nuc
     if (core_z.empty()) cx = a.centre.x(), cy = a.centre.y(), collect(cx, cy);
     if (!core_z.empty()) {
       const double z_deep = percentile(core_z, 0.02);
-      const double top = nucleus_anterior_z(nucleus, cx, cy), bottom = nucleus_posterior_z(nucleus, cx, cy);
+      const double top = nucleus_anterior_z(nucleus, cx, cy),
+                   bottom = nucleus_posterior_z(nucleus, cx, cy);
       if (std::isfinite(top) && std::isfinite(bottom)) {
         t.depth_mm = std::max(0.0, top - z_deep);
         t.depth_fraction = t.depth_mm / (top - bottom);

@@ -28,33 +28,34 @@ struct NucleusShape {
 };
 
 struct RemovedElement {
-  Vec3 centre;         // mm, lens frame
+  Vec3 centre;  // mm, lens frame
   double volume_mm3 = 0;
   uint32_t stroke = 0;
 };
 
 struct Trench {
-  Vec3 axis;                     // unit, in the iris plane (z = 0)
-  Vec3 centre;                   // volume-weighted centre of the removed material, mm
+  Vec3 axis;    // unit, in the iris plane (z = 0)
+  Vec3 centre;  // volume-weighted centre of the removed material, mm
   double width_mm = 0;
-  double depth_mm = 0;           // below the nucleus's anterior surface
-  double depth_fraction = 0;     // of the nucleus's thickness at the trench centre
-  double length_mm = 0;          // 5th–95th percentile range along the axis, /0.9
+  double depth_mm = 0;        // below the nucleus's anterior surface
+  double depth_fraction = 0;  // of the nucleus's thickness at the trench centre
+  double length_mm = 0;       // 5th–95th percentile range along the axis, /0.9
   double volume_mm3 = 0;
   std::vector<uint32_t> strokes;
 };
 
 struct TrenchReport {
-  std::vector<Trench> trenches;  // largest volume first
-  double crossing_angle_deg = 0; // between the two largest; 0 with fewer than two
+  std::vector<Trench> trenches;   // largest volume first
+  double crossing_angle_deg = 0;  // between the two largest; 0 with fewer than two
   double volume_removed_mm3 = 0;
 };
 
 struct TrenchSettings {
   double same_direction_deg = 25;  // strokes within this angle ...
-  double same_line_mm = 0.8;       // ... and this far apart (centre to the other's axis) are one trench
-  double core_radius_mm = 1.0;     // depth is measured within this distance of the lens axis
-  double min_stroke_volume_mm3 = 0.01;  // strokes that removed less are ignored (touches, not trenches)
+  double same_line_mm = 0.8;  // ... and this far apart (centre to the other's axis) are one trench
+  double core_radius_mm = 1.0;  // depth is measured within this distance of the lens axis
+  double min_stroke_volume_mm3 =
+      0.01;  // strokes that removed less are ignored (touches, not trenches)
 };
 
 // Throws std::invalid_argument if the nucleus shape is not positive.

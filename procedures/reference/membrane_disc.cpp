@@ -20,8 +20,9 @@ MembraneProfileRow membrane_profile(const MembraneCase& c) {
   const FlatDisc disc = make_flat_disc(c.radius_mm, 1000u << c.level, c.layout);
   const DiscBody body = make_disc_body(disc);
   springs::SpringMaterial material{c.law, c.weighting, c.sheet_modulus_mn_mm, c.prestretch};
-  material.pretension = c.pretension == Pretension::Cotangent ? springs::Pretension::Cotangent
-                                                              : springs::Pretension::UniformPrestretch;
+  material.pretension = c.pretension == Pretension::Cotangent
+                            ? springs::Pretension::Cotangent
+                            : springs::Pretension::UniformPrestretch;
   Springs springs = springs::build_springs(body.particles, body.triangles, material);
   row.vertices = body.particles.slots.size();
   row.springs = springs.slots.size();

@@ -9,13 +9,15 @@ namespace {
 
 double to_segment(const Vec3& x, const Vec3& a, const Vec3& b) {
   const Vec3 e = b - a;
-  const double t = e.squaredNorm() > 0 ? std::clamp((x - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+  const double t =
+      e.squaredNorm() > 0 ? std::clamp((x - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
   return (x - (a + t * e)).norm();
 }
 
 }  // namespace
 
-CutFidelity measure_cut_fidelity(const cut::CutMesh& m, std::span<const Vec3> path, double sample_mm) {
+CutFidelity measure_cut_fidelity(const cut::CutMesh& m, std::span<const Vec3> path,
+                                 double sample_mm) {
   CutFidelity f;
   if (path.size() < 2) return f;
   struct Lip {
@@ -28,8 +30,11 @@ CutFidelity measure_cut_fidelity(const cut::CutMesh& m, std::span<const Vec3> pa
     for (int k = 0; k < 3; ++k) {
       if (m.topology.adjacency.neighbour[t][k] != kInvalidIndex) continue;
       const uint32_t u = cut::corner(tr, t, k), w = cut::corner(tr, t, (k + 1) % 3);
-      if (m.particles.kind[u] == ParticleKind::Anchored && m.particles.kind[w] == ParticleKind::Anchored) continue;
-      lips.push_back({cut::particle_position(m.particles, u), cut::particle_position(m.particles, w)});
+      if (m.particles.kind[u] == ParticleKind::Anchored &&
+          m.particles.kind[w] == ParticleKind::Anchored)
+        continue;
+      lips.push_back(
+          {cut::particle_position(m.particles, u), cut::particle_position(m.particles, w)});
     }
   }
   f.lip_edges = lips.size();
@@ -38,7 +43,8 @@ CutFidelity measure_cut_fidelity(const cut::CutMesh& m, std::span<const Vec3> pa
     for (double s : {0.0, 0.5, 1.0}) {
       const Vec3 x = l.a + s * (l.b - l.a);
       double best = 1e300;
-      for (size_t k = 0; k + 1 < path.size(); ++k) best = std::min(best, to_segment(x, path[k], path[k + 1]));
+      for (size_t k = 0; k + 1 < path.size(); ++k)
+        best = std::min(best, to_segment(x, path[k], path[k + 1]));
       f.cut_to_tool_mm = std::max(f.cut_to_tool_mm, best);
     }
   }

@@ -19,6 +19,7 @@ struct CutFidelity {
 };
 
 // A path of fewer than two points, or a mesh without lips, gives lip_edges = 0 and zeros.
-CutFidelity measure_cut_fidelity(const cut::CutMesh& mesh, std::span<const Vec3> tool_path, double sample_mm = 0.01);
+CutFidelity measure_cut_fidelity(const cut::CutMesh& mesh, std::span<const Vec3> tool_path,
+                                 double sample_mm = 0.01);
 
 }  // namespace phaco::rhexis

@@ -1,9 +1,8 @@
 #include "procedures/rhexis/opening.hpp"
 
 #include <cmath>
-#include <vector>
-
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace phaco::rhexis {
 
@@ -17,7 +16,8 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
   for (uint32_t t = 0; t < nt; ++t) {
     if (!tr.slots.alive(t)) continue;
     for (int k = 0; k < 3; ++k)
-      if (m.particles.kind[cut::corner(tr, t, k)] == ParticleKind::Anchored && !held[t]) held[t] = 1, queue.push_back(t);
+      if (m.particles.kind[cut::corner(tr, t, k)] == ParticleKind::Anchored && !held[t])
+        held[t] = 1, queue.push_back(t);
   }
   for (size_t q = 0; q < queue.size(); ++q) {
     for (uint32_t n : m.topology.adjacency.neighbour[queue[q]]) {
@@ -43,8 +43,8 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
   cv::floodFill(region, centre, cv::Scalar(128));
   cv::Mat hole = region == 128;
   // Open to the field's edge: the uncovered region is not enclosed.
-  if (cv::countNonZero(hole.row(0)) || cv::countNonZero(hole.row(size - 1)) || cv::countNonZero(hole.col(0)) ||
-      cv::countNonZero(hole.col(size - 1)))
+  if (cv::countNonZero(hole.row(0)) || cv::countNonZero(hole.row(size - 1)) ||
+      cv::countNonZero(hole.col(0)) || cv::countNonZero(hole.col(size - 1)))
     return out;
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(hole, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
@@ -72,7 +72,8 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
       if (m.topology.adjacency.neighbour[t][k] != kInvalidIndex) continue;
       const uint32_t u = cut::corner(tr, t, k), w = cut::corner(tr, t, (k + 1) % 3);
       if (inside(px(u)) && inside(px(w)))
-        out.perimeter_mm += std::hypot(m.particles.x[u] - m.particles.x[w], m.particles.y[u] - m.particles.y[w]);
+        out.perimeter_mm +=
+            std::hypot(m.particles.x[u] - m.particles.x[w], m.particles.y[u] - m.particles.y[w]);
     }
   }
   // A lip folded over the opening hides some of its edges from that count: the perimeter is never
@@ -88,12 +89,14 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
                                                (out.perimeter_mm * out.perimeter_mm)
                                          : 0.0;
   const cv::RotatedRect e = cv::fitEllipse(c);
-  const double major = std::max(e.size.width, e.size.height), minor = std::min(e.size.width, e.size.height);
+  const double major = std::max(e.size.width, e.size.height),
+               minor = std::min(e.size.width, e.size.height);
   out.ellipse_diameter_mm = 0.5 * (major + minor) * pixel_mm;
   out.ellipse_axis_ratio = major > 0 ? minor / major : 0.0;
   const cv::Moments mo = cv::moments(hole, true);
   if (mo.m00 > 0) {
-    const double cx = mo.m10 / mo.m00 * pixel_mm - field_mm, cy = mo.m01 / mo.m00 * pixel_mm - field_mm;
+    const double cx = mo.m10 / mo.m00 * pixel_mm - field_mm,
+                 cy = mo.m01 / mo.m00 * pixel_mm - field_mm;
     out.centering_mm = std::hypot(cx, cy);
   }
   return out;

@@ -27,8 +27,8 @@ struct Opening {
   double ellipse_diameter_mm = 0.0;  // mean of the fitted ellipse's axes
   double ellipse_axis_ratio = 0.0;   // minor / major
   double perimeter_mm = 0.0;
-  double circularity = 0.0;          // 4πA/P²
-  double centering_mm = 0.0;         // centroid distance from the optical axis
+  double circularity = 0.0;   // 4πA/P²
+  double centering_mm = 0.0;  // centroid distance from the optical axis
   // The opening's contour seen down the axis, simplified to within a pixel, closed implicitly
   // (x, y in mm, scene frame): what a report draws against the target circle.
   std::vector<std::array<double, 2>> outline_mm;

@@ -9,18 +9,22 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double polar_angle(const Vec3& p) { return std::atan2(p.y(), p.x()); }
+double polar_angle(const Vec3& p) {
+  return std::atan2(p.y(), p.x());
+}
 
 }  // namespace
 
-Vec3 surface_below(const cut::CutMesh& m, double x, double y, uint32_t& hint, const cut::SnapSettings& snap) {
+Vec3 surface_below(const cut::CutMesh& m, double x, double y, uint32_t& hint,
+                   const cut::SnapSettings& snap) {
   // The capsule is a height field over the iris plane: the highest triangle over (x, y) holds the
   // point. A scan (scripting only, outside any timed step); off the mesh, the nearest point.
   const Triangles& tr = m.triangles;
   double best_z = -1e300;
   for (uint32_t t = 0; t < tr.slots.size(); ++t) {
     if (!tr.slots.alive(t)) continue;
-    const Vec3 a = cut::particle_position(m.particles, tr.a[t]), b = cut::particle_position(m.particles, tr.b[t]),
+    const Vec3 a = cut::particle_position(m.particles, tr.a[t]),
+               b = cut::particle_position(m.particles, tr.b[t]),
                c = cut::particle_position(m.particles, tr.c[t]);
     const double det = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
     if (std::abs(det) < 1e-300) continue;
@@ -31,15 +35,19 @@ Vec3 surface_below(const cut::CutMesh& m, double x, double y, uint32_t& hint, co
     if (z > best_z) best_z = z, hint = t;
   }
   if (best_z > -1e300) return Vec3(x, y, best_z);
-  const cut::CutPoint c = cut::locate_cut_point(m.particles, m.triangles, m.topology.adjacency, hint, Vec3(x, y, 10.0), snap);
+  const cut::CutPoint c = cut::locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
+                                                hint, Vec3(x, y, 10.0), snap);
   hint = c.triangle;
   return c.position;
 }
 
-RhexisResult run_scripted_rhexis(cut::CutMesh& m, const RhexisScript& s, const tear::TearSettings& tear,
-                                 const cut::CutSettings& cut) {
-  if (!(s.radius_mm > 0) || !(s.pull_mn > 0) || !(s.cystotome_sample_mm > 0) || !(s.regrasp_every_deg > 0))
-    throw std::invalid_argument("scripted rhexis: radius_mm, pull_mn, cystotome_sample_mm and regrasp_every_deg must be > 0");
+RhexisResult run_scripted_rhexis(cut::CutMesh& m, const RhexisScript& s,
+                                 const tear::TearSettings& tear, const cut::CutSettings& cut) {
+  if (!(s.radius_mm > 0) || !(s.pull_mn > 0) || !(s.cystotome_sample_mm > 0) ||
+      !(s.regrasp_every_deg > 0))
+    throw std::invalid_argument(
+        "scripted rhexis: radius_mm, pull_mn, cystotome_sample_mm and regrasp_every_deg must be > "
+        "0");
   RhexisResult out;
   cut::CutPath path;
   cut::EditLog log;
@@ -49,11 +57,13 @@ RhexisResult run_scripted_rhexis(cut::CutMesh& m, const RhexisScript& s, const t
   const double r_bend = 0.8 * s.radius_mm, bend = s.flap_start_deg * kPi / 180.0;
   for (double r = 0.0; r < r_bend; r += s.cystotome_sample_mm)
     cut::cut_towards(m, path, surface_below(m, r, 0.0, hint, cut.snap), cut, log);
-  const int bend_samples = std::max(4, static_cast<int>(std::ceil(1.6 * s.radius_mm * bend / s.cystotome_sample_mm)));
+  const int bend_samples =
+      std::max(4, static_cast<int>(std::ceil(1.6 * s.radius_mm * bend / s.cystotome_sample_mm)));
   for (int k = 0; k <= bend_samples; ++k) {
     const double f = static_cast<double>(k) / bend_samples;
     const double r = r_bend + (s.radius_mm - r_bend) * std::sin(0.5 * kPi * f), th = bend * f;
-    cut::cut_towards(m, path, surface_below(m, r * std::cos(th), r * std::sin(th), hint, cut.snap), cut, log);
+    cut::cut_towards(m, path, surface_below(m, r * std::cos(th), r * std::sin(th), hint, cut.snap),
+                     cut, log);
   }
   if (path.tip == kInvalidIndex) return out;
   const Vec3 flap = cut::particle_position(m.particles, path.tip);
@@ -77,7 +87,8 @@ RhexisResult run_scripted_rhexis(cut::CutMesh& m, const RhexisScript& s, const t
     const Vec3 force = s.pull_mn * (aim - tip).normalized();
     const auto t0 = std::chrono::steady_clock::now();
     tear::tear_step(m, path, state, force, tear, cut, log);
-    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+    const double us =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
     total_us += us;
     out.tear_step_us_max = std::max(out.tear_step_us_max, us);
     ++out.tear_steps;
@@ -96,8 +107,10 @@ RhexisResult run_scripted_rhexis(cut::CutMesh& m, const RhexisScript& s, const t
   out.radial_tearouts = state.count(tear::TearEvent::RadialTearout);
   out.max_radius_mm = state.max_radius_mm;
   for (const auto& e : state.events) {
-    if (e.kind == tear::TearEvent::RunoutWarning && out.first_warning_radius_mm < 0) out.first_warning_radius_mm = e.radius_mm;
-    if (e.kind == tear::TearEvent::RadialTearout && out.tearout_radius_mm < 0) out.tearout_radius_mm = e.radius_mm;
+    if (e.kind == tear::TearEvent::RunoutWarning && out.first_warning_radius_mm < 0)
+      out.first_warning_radius_mm = e.radius_mm;
+    if (e.kind == tear::TearEvent::RadialTearout && out.tearout_radius_mm < 0)
+      out.tearout_radius_mm = e.radius_mm;
   }
   out.tear_step_us_mean = out.tear_steps ? total_us / out.tear_steps : 0.0;
   out.opening = measure_opening(m);

@@ -44,8 +44,8 @@
 #include <cstdint>
 
 #include "systems/cut/membrane_edit.hpp"
-#include "systems/cut/vertex_insertion.hpp"
 #include "systems/cut/progressive_cut.hpp"
+#include "systems/cut/vertex_insertion.hpp"
 
 namespace phaco::cut {
 

@@ -24,7 +24,8 @@ struct MembraneSheet {
   CutMesh mesh() { return {particles, triangles, springs, topology, material}; }
 };
 
-inline MembraneSheet make_membrane_sheet(const SurfaceMesh& mesh, const MembraneMaterial& material) {
+inline MembraneSheet make_membrane_sheet(const SurfaceMesh& mesh,
+                                         const MembraneMaterial& material) {
   MembraneSheet s;
   s.material = material;
   s.particles = particles_at(mesh.vertices, ParticleKind::Free, 1.0f);

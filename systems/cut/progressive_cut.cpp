@@ -13,14 +13,16 @@ constexpr double kStuckTol = 1e-9;  // exit parameter this close to 0: no way fo
 // Where a cut point will become a mesh vertex.
 struct Placement {
   CutPoint::Kind kind = CutPoint::Vertex;
-  uint32_t triangle = kInvalidIndex;  // Face
-  Vec3 bary = Vec3::Zero();           // Face: weights of the triangle's corners
+  uint32_t triangle = kInvalidIndex;              // Face
+  Vec3 bary = Vec3::Zero();                       // Face: weights of the triangle's corners
   uint32_t a = kInvalidIndex, b = kInvalidIndex;  // Edge ends; Vertex: a
-  double t = 0.0;                     // Edge: from a
-  double moved_mm = 0.0;              // how far snapping moved the point
+  double t = 0.0;                                 // Edge: from a
+  double moved_mm = 0.0;                          // how far snapping moved the point
 };
 
-Vec3 pos(const CutMesh& m, uint32_t v) { return particle_position(m.particles, v); }
+Vec3 pos(const CutMesh& m, uint32_t v) {
+  return particle_position(m.particles, v);
+}
 
 // Smallest angle a split would leave, over the current and the rest shape.
 double edge_split_quality(const CutMesh& m, uint32_t a, uint32_t b, double t) {
@@ -32,9 +34,11 @@ double edge_split_quality(const CutMesh& m, uint32_t a, uint32_t b, double t) {
   for (uint32_t T : tris) {
     uint32_t x = kInvalidIndex;
     for (int k = 0; k < 3; ++k)
-      if (corner(m.triangles, T, k) != a && corner(m.triangles, T, k) != b) x = corner(m.triangles, T, k);
+      if (corner(m.triangles, T, k) != a && corner(m.triangles, T, k) != b)
+        x = corner(m.triangles, T, k);
     const Vec3 rx = rest_position(m.topology, x);
-    worst = std::min({worst, min_angle_deg(pos(m, a), q, pos(m, x)), min_angle_deg(q, pos(m, b), pos(m, x)),
+    worst = std::min({worst, min_angle_deg(pos(m, a), q, pos(m, x)),
+                      min_angle_deg(q, pos(m, b), pos(m, x)),
                       min_angle_deg(rest_position(m.topology, a), rq, rx),
                       min_angle_deg(rq, rest_position(m.topology, b), rx)});
   }
@@ -46,9 +50,11 @@ double face_split_quality(const CutMesh& m, uint32_t T, const Vec3& w) {
   for (int shape = 0; shape < 2; ++shape) {
     Vec3 c[3];
     for (int k = 0; k < 3; ++k)
-      c[k] = shape == 0 ? pos(m, corner(m.triangles, T, k)) : rest_position(m.topology, corner(m.triangles, T, k));
+      c[k] = shape == 0 ? pos(m, corner(m.triangles, T, k))
+                        : rest_position(m.topology, corner(m.triangles, T, k));
     const Vec3 q = w[0] * c[0] + w[1] * c[1] + w[2] * c[2];
-    worst = std::min({worst, min_angle_deg(c[0], c[1], q), min_angle_deg(c[1], c[2], q), min_angle_deg(c[2], c[0], q)});
+    worst = std::min({worst, min_angle_deg(c[0], c[1], q), min_angle_deg(c[1], c[2], q),
+                      min_angle_deg(c[2], c[0], q)});
   }
   return worst;
 }
@@ -114,9 +120,12 @@ Placement place(const CutMesh& m, uint32_t T, Vec3 w, const CutSettings& s, uint
 
 uint32_t realise(CutMesh& m, const Placement& p, EditLog& log) {
   switch (p.kind) {
-    case CutPoint::Face: return split_face(m, p.triangle, p.bary, log);
-    case CutPoint::Edge: return split_edge(m, p.a, p.b, p.t, log);
-    default: return p.a;
+    case CutPoint::Face:
+      return split_face(m, p.triangle, p.bary, log);
+    case CutPoint::Edge:
+      return split_edge(m, p.a, p.b, p.t, log);
+    default:
+      return p.a;
   }
 }
 
@@ -132,8 +141,9 @@ bool own_lip(const CutMesh& m, uint32_t tip, uint32_t v, uint32_t hops) {
       for (uint32_t t : fan) {
         const int k = corner_slot(m.triangles, t, u);
         const auto& nb = m.topology.adjacency.neighbour[t];
-        const uint32_t ends[2] = {nb[k] == kInvalidIndex ? corner(m.triangles, t, (k + 1) % 3) : kInvalidIndex,
-                                  nb[(k + 2) % 3] == kInvalidIndex ? corner(m.triangles, t, (k + 2) % 3) : kInvalidIndex};
+        const uint32_t ends[2] = {
+            nb[k] == kInvalidIndex ? corner(m.triangles, t, (k + 1) % 3) : kInvalidIndex,
+            nb[(k + 2) % 3] == kInvalidIndex ? corner(m.triangles, t, (k + 2) % 3) : kInvalidIndex};
         for (uint32_t w : ends) {
           if (w == kInvalidIndex || std::find(seen.begin(), seen.end(), w) != seen.end()) continue;
           if (w == v) return true;
@@ -151,13 +161,17 @@ bool own_lip(const CutMesh& m, uint32_t tip, uint32_t v, uint32_t hops) {
 
 std::string_view to_string(CutCase c) {
   static constexpr std::string_view names[kCutCases] = {"IC1", "IC2", "IC3", "IC4", "IC5",
-                                                         "IC6", "SC1", "SC2", "SC3"};
+                                                        "IC6", "SC1", "SC2", "SC3"};
   return names[static_cast<int>(c)];
 }
 
 CutCase classify_cut(CutPoint::Kind from, CutPoint::Kind to, bool subsequent) {
-  if (subsequent) return to == CutPoint::Face ? CutCase::SC1 : (to == CutPoint::Edge ? CutCase::SC2 : CutCase::SC3);
-  if (from == to) return from == CutPoint::Face ? CutCase::IC1 : (from == CutPoint::Edge ? CutCase::IC2 : CutCase::IC3);
+  if (subsequent)
+    return to == CutPoint::Face ? CutCase::SC1
+                                : (to == CutPoint::Edge ? CutCase::SC2 : CutCase::SC3);
+  if (from == to)
+    return from == CutPoint::Face ? CutCase::IC1
+                                  : (from == CutPoint::Edge ? CutCase::IC2 : CutCase::IC3);
   const bool face = from == CutPoint::Face || to == CutPoint::Face;
   const bool edge = from == CutPoint::Edge || to == CutPoint::Edge;
   if (face && edge) return CutCase::IC4;
@@ -172,7 +186,8 @@ void end_cut(CutPath& path) {
   path.direction = Vec3::Zero();
 }
 
-bool finish_cut(CutMesh& m, CutPath& path, const CutSettings& settings, double min_angle_deg, EditLog& log) {
+bool finish_cut(CutMesh& m, CutPath& path, const CutSettings& settings, double min_angle_deg,
+                EditLog& log) {
   bool made = false;
   for (int attempt = 0; attempt < 2; ++attempt) {
     if (path.tip == kInvalidIndex || !m.particles.slots.alive(path.tip) || path.reached_boundary ||
@@ -190,23 +205,27 @@ bool finish_cut(CutMesh& m, CutPath& path, const CutSettings& settings, double m
   return made;
 }
 
-SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, const CutSettings& s, EditLog& log) {
+SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, const CutSettings& s,
+                          EditLog& log) {
   SegmentReport r;
-  if (!tool_point.allFinite()) throw std::invalid_argument("cut_towards: the tool point is not finite");
+  if (!tool_point.allFinite())
+    throw std::invalid_argument("cut_towards: the tool point is not finite");
   if (path.reached_boundary) {
     r.reached_boundary = true;
     return r;
   }
   path.tool_points.push_back(tool_point);
-  CutPoint target = locate_cut_point(m.particles, m.triangles, m.topology.adjacency, path.hint_triangle,
-                                     tool_point, s.snap);
+  CutPoint target = locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
+                                     path.hint_triangle, tool_point, s.snap);
   if (path.tip != kInvalidIndex && target.distance_mm > s.snap.vertex_snap_mm) {
     // The walk can stop on a lip of the cut, the point lying across it: walk again from every
     // triangle round the tip (the crack tip joins both sides), and keep the nearest.
     std::vector<uint32_t> fan;
-    vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[path.tip], path.tip, fan);
+    vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[path.tip], path.tip,
+               fan);
     for (uint32_t t : fan) {
-      const CutPoint c = locate_cut_point(m.particles, m.triangles, m.topology.adjacency, t, tool_point, s.snap);
+      const CutPoint c =
+          locate_cut_point(m.particles, m.triangles, m.topology.adjacency, t, tool_point, s.snap);
       if (c.distance_mm < target.distance_mm) target = c;
     }
   }
@@ -222,12 +241,13 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
   if (!subsequent) {
     // The initial cut's first point becomes a vertex (it may have moved since it was sampled: use
     // its position now, located again).
-    const CutPoint c0 = locate_cut_point(m.particles, m.triangles, m.topology.adjacency, path.first.triangle,
-                                         path.first.position, s.snap);
+    const CutPoint c0 = locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
+                                         path.first.triangle, path.first.position, s.snap);
     const Placement p0 = place(m, c0.triangle, c0.bary, s, kInvalidIndex);
     from_kind = p0.kind;
     path.max_snap_mm = std::max(path.max_snap_mm, p0.moved_mm);
-    if ((c0.position - target.position).norm() <= s.snap.vertex_snap_mm) return r;  // nothing to cut yet
+    if ((c0.position - target.position).norm() <= s.snap.vertex_snap_mm)
+      return r;  // nothing to cut yet
     path.tip = realise(m, p0, log);
     path.sources.push_back(path.tip);
   }
@@ -283,7 +303,8 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     // onto it is going back or sideways into the incision, not cutting through (a tool lifting
     // off, a sample just behind the tip, a flap dragged over its own cut).
     if (boundary && path.direction.squaredNorm() > 0 &&
-        (own_lip(m, tip, p.a, s.own_lip_hops) || (p.kind == CutPoint::Edge && own_lip(m, tip, p.b, s.own_lip_hops)))) {
+        (own_lip(m, tip, p.a, s.own_lip_hops) ||
+         (p.kind == CutPoint::Edge && own_lip(m, tip, p.b, s.own_lip_hops)))) {
       r.stalled = true;
       break;
     }
@@ -314,7 +335,8 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     ++path.span_counts[std::min<uint32_t>(r.triangles_spanned, 3)];
     ++path.segments;
   }
-  for (size_t i = new_before; i < log.new_particles.size(); ++i) path.sources.push_back(log.new_particles[i]);
+  for (size_t i = new_before; i < log.new_particles.size(); ++i)
+    path.sources.push_back(log.new_particles[i]);
   if (s.remesh && r.made) {
     // Fig. 5a: merge pairs along the new path edges (both lips), never at the tip.
     for (size_t i = new_before; i < log.new_particles.size(); ++i) {
@@ -323,12 +345,14 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
         merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
     }
     for (uint32_t v : visited)
-      if (v != path.tip && m.particles.slots.alive(v)) merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
+      if (v != path.tip && m.particles.slots.alive(v))
+        merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
   }
   {
     EditLog region;
-    region.touched_triangles.assign(log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
-                                    log.touched_triangles.end());
+    region.touched_triangles.assign(
+        log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
+        log.touched_triangles.end());
     refresh_region(m, region);
     log.clamped_pretension += region.clamped_pretension;
   }

@@ -44,32 +44,32 @@ CutCase classify_cut(CutPoint::Kind from, CutPoint::Kind to, bool subsequent);
 
 struct CutSettings {
   SnapSettings snap;
-  double min_angle_deg = 5.0;          // no split may make a smaller angle (invariants ask ≥ 1°)
-  bool remesh = true;                  // Fig. 5a merging along the path
-  double remesh_max_turn_deg = 10.0;   // "almost co-linear" cut edges
+  double min_angle_deg = 5.0;         // no split may make a smaller angle (invariants ask ≥ 1°)
+  bool remesh = true;                 // Fig. 5a merging along the path
+  double remesh_max_turn_deg = 10.0;  // "almost co-linear" cut edges
   uint32_t max_steps_per_segment = 4096;
-  uint32_t own_lip_hops = 12;          // a boundary this close to the tip along free edges is the
-                                       // cut's own lip, not a boundary to cut through to
+  uint32_t own_lip_hops = 12;  // a boundary this close to the tip along free edges is the
+                               // cut's own lip, not a boundary to cut through to
 };
 
 struct CutPath {
-  bool started = false;                // a first cut point is known
-  CutPoint first;                      // c_0, until the initial cut makes it a vertex
-  uint32_t tip = kInvalidIndex;        // c_t as a mesh vertex, once the initial cut is made
-  Vec3 direction = Vec3::Zero();       // unit direction of the last segment made (ĉ_t)
-  uint32_t hint_triangle = 0;          // where to start locating the next point
-  bool reached_boundary = false;       // the path met the rim or an earlier cut: it is through
-  uint32_t segments = 0;               // segments that changed the mesh
-  double max_snap_mm = 0.0;            // the furthest any cut point was moved by snapping
-  std::vector<Vec3> tool_points;       // every sample the path was cut toward
-  std::vector<uint32_t> sources;       // cut-path particles, both lips (may include removed ones)
+  bool started = false;           // a first cut point is known
+  CutPoint first;                 // c_0, until the initial cut makes it a vertex
+  uint32_t tip = kInvalidIndex;   // c_t as a mesh vertex, once the initial cut is made
+  Vec3 direction = Vec3::Zero();  // unit direction of the last segment made (ĉ_t)
+  uint32_t hint_triangle = 0;     // where to start locating the next point
+  bool reached_boundary = false;  // the path met the rim or an earlier cut: it is through
+  uint32_t segments = 0;          // segments that changed the mesh
+  double max_snap_mm = 0.0;       // the furthest any cut point was moved by snapping
+  std::vector<Vec3> tool_points;  // every sample the path was cut toward
+  std::vector<uint32_t> sources;  // cut-path particles, both lips (may include removed ones)
   std::array<uint32_t, kCutCases> case_counts{};
   std::array<uint32_t, 4> span_counts{};  // segments spanning 0, 1, 2, ≥3 triangles
 };
 
 struct SegmentReport {
   CutCase cut_case = CutCase::IC1;
-  bool made = false;              // the mesh changed
+  bool made = false;  // the mesh changed
   uint32_t triangles_spanned = 0;
   uint32_t steps = 0;             // one-triangle steps of the decomposition
   bool reached_boundary = false;  // the path ended on the rim or an earlier cut
@@ -79,8 +79,8 @@ struct SegmentReport {
 // Extends the path toward the tool's sample (its nearest surface point). The first sample of a
 // path only records c_0. Throws std::invalid_argument for a non-finite point. After the path has
 // reached a boundary, further samples are ignored until end_cut.
-SegmentReport cut_towards(CutMesh& mesh, CutPath& path, const Vec3& tool_point, const CutSettings& settings,
-                          EditLog& log);
+SegmentReport cut_towards(CutMesh& mesh, CutPath& path, const Vec3& tool_point,
+                          const CutSettings& settings, EditLog& log);
 
 // The tool left the mesh: the next sample starts a new path (a new initial cut).
 void end_cut(CutPath& path);
@@ -91,6 +91,7 @@ void end_cut(CutPath& path);
 // if it still waits, with a vertex snap just under its gap, so the end goes to a vertex nearer the
 // sample than the tip is, if one is in the way (the cut may then pass the sample by less than it
 // would have fallen short). Returns true if the mesh changed; call before end_cut.
-bool finish_cut(CutMesh& mesh, CutPath& path, const CutSettings& settings, double min_angle_deg, EditLog& log);
+bool finish_cut(CutMesh& mesh, CutPath& path, const CutSettings& settings, double min_angle_deg,
+                EditLog& log);
 
 }  // namespace phaco::cut

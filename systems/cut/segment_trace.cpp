@@ -23,7 +23,6 @@ struct Location {
   Vec3 position = Vec3::Zero();
 };
 
-
 // Barycentric weights of the location in triangle T (which holds it).
 Vec3 bary_in(const Triangles& tr, const Location& l, uint32_t T) {
   Vec3 w = Vec3::Zero();

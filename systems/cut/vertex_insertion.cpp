@@ -14,14 +14,18 @@ namespace {
 constexpr double kRestoreMinAreaMm2 = 1e-8;  // systems/topology_check's default thresholds
 constexpr double kRestoreMinAngleDeg = 1.0;
 
-std::array<uint32_t, 3> corners_of(const Triangles& tr, uint32_t t) { return {tr.a[t], tr.b[t], tr.c[t]}; }
+std::array<uint32_t, 3> corners_of(const Triangles& tr, uint32_t t) {
+  return {tr.a[t], tr.b[t], tr.c[t]};
+}
 
 // Records the star of the new vertex (its fan, reached from its hint) after a split.
 void record_star(const CutMesh& m, VertexInsertion& ins) {
   std::vector<uint32_t> fan;
-  vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[ins.vertex], ins.vertex, fan);
+  vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[ins.vertex], ins.vertex,
+             fan);
   if (fan.size() != (ins.kind == CutPoint::Face ? 3u : 2u * ins.original_count))
-    throw std::logic_error("split recording: the new vertex has " + std::to_string(fan.size()) + " triangles");
+    throw std::logic_error("split recording: the new vertex has " + std::to_string(fan.size()) +
+                           " triangles");
   ins.piece_count = static_cast<uint32_t>(fan.size());
   for (size_t i = 0; i < fan.size(); ++i) {
     ins.piece_slot[i] = fan[i];
@@ -54,7 +58,8 @@ VertexInsertion split_edge_recorded(CutMesh& m, uint32_t a, uint32_t b, double t
   std::vector<uint32_t> tris;
   triangles_on_edge(m, a, b, tris);
   if (tris.size() > 2 || is_slit(m, a, b))
-    throw std::invalid_argument("split_edge_recorded: (" + std::to_string(a) + ", " + std::to_string(b) +
+    throw std::invalid_argument("split_edge_recorded: (" + std::to_string(a) + ", " +
+                                std::to_string(b) +
                                 ") is a slit or non-manifold edge; its split cannot be undone");
   VertexInsertion ins;
   ins.kind = CutPoint::Edge;
@@ -72,21 +77,25 @@ VertexInsertion split_edge_recorded(CutMesh& m, uint32_t a, uint32_t b, double t
 
 InsertionState insertion_state(const CutMesh& m, const VertexInsertion& ins) {
   const uint32_t q = ins.vertex;
-  if (ins.kind == CutPoint::Vertex || q == kInvalidIndex || !m.particles.slots.alive(q)) return InsertionState::Gone;
+  if (ins.kind == CutPoint::Vertex || q == kInvalidIndex || !m.particles.slots.alive(q))
+    return InsertionState::Gone;
   const Triangles& tr = m.triangles;
   for (uint32_t i = 0; i < ins.piece_count; ++i) {
     const uint32_t t = ins.piece_slot[i];
-    if (!tr.slots.alive(t) || corners_of(tr, t) != ins.piece_corners[i]) return InsertionState::Changed;
+    if (!tr.slots.alive(t) || corners_of(tr, t) != ins.piece_corners[i])
+      return InsertionState::Changed;
     for (int k = 0; k < 3; ++k) {
       const bool through_q = corner(tr, t, k) == q || corner(tr, t, (k + 1) % 3) == q;
-      if (through_q && m.topology.adjacency.neighbour[t][k] != ins.piece_links[i][k]) return InsertionState::Changed;
+      if (through_q && m.topology.adjacency.neighbour[t][k] != ins.piece_links[i][k])
+        return InsertionState::Changed;
     }
   }
   for (uint32_t i = 0; i < ins.original_count; ++i) {
     const auto& c = ins.original_corners[i];
     const Vec3 p0 = particle_position(m.particles, c[0]), p1 = particle_position(m.particles, c[1]),
                p2 = particle_position(m.particles, c[2]);
-    if (0.5 * (p1 - p0).cross(p2 - p0).norm() < kRestoreMinAreaMm2 || min_angle_deg(p0, p1, p2) < kRestoreMinAngleDeg)
+    if (0.5 * (p1 - p0).cross(p2 - p0).norm() < kRestoreMinAreaMm2 ||
+        min_angle_deg(p0, p1, p2) < kRestoreMinAngleDeg)
       return InsertionState::Degenerate;
   }
   return InsertionState::Intact;
@@ -113,7 +122,8 @@ bool remove_inserted_vertex(CutMesh& m, const VertexInsertion& ins, EditLog& log
       }
       outer[i][k] = kInvalidIndex;
       for (uint32_t j = 0; j < ins.piece_count; ++j)
-        if (detail::edge_slot(tr, ins.piece_slot[j], u, v) >= 0) outer[i][k] = detail::link_across(m, ins.piece_slot[j], u, v);
+        if (detail::edge_slot(tr, ins.piece_slot[j], u, v) >= 0)
+          outer[i][k] = detail::link_across(m, ins.piece_slot[j], u, v);
     }
   }
   // The vertex's neighbours, for its springs.
@@ -133,7 +143,8 @@ bool remove_inserted_vertex(CutMesh& m, const VertexInsertion& ins, EditLog& log
     tr.a[t] = c[0], tr.b[t] = c[1], tr.c[t] = c[2];
     nb[t] = outer[i];
     for (int k = 0; k < 3; ++k)
-      if (outer[i][k] != kInvalidIndex && !is_original(outer[i][k])) detail::set_link(m, outer[i][k], c[k], c[(k + 1) % 3], t);
+      if (outer[i][k] != kInvalidIndex && !is_original(outer[i][k]))
+        detail::set_link(m, outer[i][k], c[k], c[(k + 1) % 3], t);
     for (uint32_t v : c) m.topology.vertex_triangle[v] = t;
     log.touched_triangles.push_back(t);
   }
@@ -155,7 +166,8 @@ double edge_split_min_angle(const CutMesh& m, uint32_t a, uint32_t b, double t) 
   for (uint32_t T : tris) {
     uint32_t x = kInvalidIndex;
     for (int k = 0; k < 3; ++k)
-      if (corner(m.triangles, T, k) != a && corner(m.triangles, T, k) != b) x = corner(m.triangles, T, k);
+      if (corner(m.triangles, T, k) != a && corner(m.triangles, T, k) != b)
+        x = corner(m.triangles, T, k);
     worst = std::min({worst, min_angle_deg(pos(a), q, pos(x)), min_angle_deg(q, pos(b), pos(x)),
                       min_angle_deg(rest(a), rq, rest(x)), min_angle_deg(rq, rest(b), rest(x))});
   }
@@ -172,7 +184,8 @@ double face_split_min_angle(const CutMesh& m, uint32_t T, const Vec3& bary) {
       c[k] = shape == 0 ? particle_position(m.particles, v) : rest_position(m.topology, v);
     }
     const Vec3 q = w[0] * c[0] + w[1] * c[1] + w[2] * c[2];
-    worst = std::min({worst, min_angle_deg(c[0], c[1], q), min_angle_deg(c[1], c[2], q), min_angle_deg(c[2], c[0], q)});
+    worst = std::min({worst, min_angle_deg(c[0], c[1], q), min_angle_deg(c[1], c[2], q),
+                      min_angle_deg(c[2], c[0], q)});
   }
   return worst;
 }

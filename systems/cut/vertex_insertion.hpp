@@ -26,14 +26,15 @@ struct VertexInsertion {
   CutPoint::Kind kind = CutPoint::Vertex;  // Face: by split_face; Edge: by split_edge; Vertex: none
   uint32_t vertex = kInvalidIndex;         // the inserted particle
   uint32_t a = kInvalidIndex, b = kInvalidIndex;  // Edge: the split edge's ends, as given
-  Vec3 weights = Vec3::Zero();             // Face: of original_corners[0]; Edge: (1-t, t, 0) of (a, b)
-  uint32_t original_count = 0;             // 1 (a face, or an edge on the rim or a cut lip) or 2
+  Vec3 weights = Vec3::Zero();  // Face: of original_corners[0]; Edge: (1-t, t, 0) of (a, b)
+  uint32_t original_count = 0;  // 1 (a face, or an edge on the rim or a cut lip) or 2
   std::array<uint32_t, 2> original_slot{kInvalidIndex, kInvalidIndex};
   std::array<std::array<uint32_t, 3>, 2> original_corners{};
-  uint32_t piece_count = 0;                // 3 (face), 2 or 4 (edge)
+  uint32_t piece_count = 0;  // 3 (face), 2 or 4 (edge)
   std::array<uint32_t, 4> piece_slot{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
   std::array<std::array<uint32_t, 3>, 4> piece_corners{};
-  std::array<std::array<uint32_t, 3>, 4> piece_links{};  // across edge k; checked where it holds the vertex
+  std::array<std::array<uint32_t, 3>, 4>
+      piece_links{};  // across edge k; checked where it holds the vertex
 };
 
 // Two triangles hold edge (a, b) but are not neighbours across it (a slit, or an opened cut whose

@@ -10,15 +10,18 @@ namespace {
 
 // Φ(x_n + α·Δx) over the unknowns and `springs`; the terms the step cannot change are left out.
 double incremental_potential(const Membrane& m, double dt, std::span<const uint32_t> unknowns,
-                             std::span<const uint32_t> unknown_of, std::span<const uint32_t> springs,
-                             const double* step_dx, double alpha) {
+                             std::span<const uint32_t> unknown_of,
+                             std::span<const uint32_t> springs, const double* step_dx,
+                             double alpha) {
   const Particles& p = m.particles;
   const Springs& s = m.springs;
   const Dynamics& dyn = m.dynamics;
   const double drag = double(dyn.damping_per_s) + dyn.viscosity_per_s;
   const bool glued = m.glue && m.glue->x.size() == p.slots.size();
   const double glue_k = glued ? dyn.glue_stiffness_mn_mm : 0.0;
-  auto coord = [&](uint32_t i, int a) -> double { return a == 0 ? p.x[i] : a == 1 ? p.y[i] : p.z[i]; };
+  auto coord = [&](uint32_t i, int a) -> double {
+    return a == 0 ? p.x[i] : a == 1 ? p.y[i] : p.z[i];
+  };
   auto at = [&](uint32_t i, int a) {
     const uint32_t u = unknown_of[i];
     return u == kNotUnknown ? coord(i, a) : coord(i, a) + alpha * step_dx[3 * u + a];
@@ -32,7 +35,10 @@ double incremental_potential(const Membrane& m, double dt, std::span<const uint3
     for (int a = 0; a < 3; ++a) {
       const double dx = alpha * step_dx[3 * u + a], x = coord(i, a) + dx;
       const double inertial = dx - dt * v[a];
-      const double rest = glued ? (a == 0 ? m.glue->x[i] : a == 1 ? m.glue->y[i] : m.glue->z[i]) : x;
+      const double rest = glued ? (a == 0   ? m.glue->x[i]
+                                   : a == 1 ? m.glue->y[i]
+                                            : m.glue->z[i])
+                                : x;
       phi += mass / (2.0 * dt * dt) * inertial * inertial + mass * drag / (2.0 * dt) * dx * dx +
              0.5 * glue_k * (x - rest) * (x - rest) - true_mass * dyn.gravity_mm_s2[a] * x;
     }
@@ -40,7 +46,8 @@ double incremental_potential(const Membrane& m, double dt, std::span<const uint3
   for (const PointLoad& load : m.loads) {  // a constant force's potential is −F·x
     if (load.particle >= unknown_of.size() || unknown_of[load.particle] == kNotUnknown) continue;
     if (!std::isfinite(load.fx) || !std::isfinite(load.fy) || !std::isfinite(load.fz)) continue;
-    phi -= load.fx * at(load.particle, 0) + load.fy * at(load.particle, 1) + load.fz * at(load.particle, 2);
+    phi -= load.fx * at(load.particle, 0) + load.fy * at(load.particle, 1) +
+           load.fz * at(load.particle, 2);
   }
   for (uint32_t e : springs) {
     const uint32_t i = s.i[e], j = s.j[e];
@@ -66,12 +73,14 @@ void add_point_loads(const Membrane& m, std::span<const uint32_t> unknown_of, do
   }
 }
 
-double line_search(const Membrane& m, double dt, int max_halvings, std::span<const uint32_t> unknowns,
-                   std::span<const uint32_t> unknown_of, std::span<const uint32_t> springs, const double* step_dx) {
+double line_search(const Membrane& m, double dt, int max_halvings,
+                   std::span<const uint32_t> unknowns, std::span<const uint32_t> unknown_of,
+                   std::span<const uint32_t> springs, const double* step_dx) {
   const double phi0 = incremental_potential(m, dt, unknowns, unknown_of, springs, step_dx, 0.0);
   double alpha = 1.0;
   for (int h = 0; h < max_halvings; ++h, alpha *= 0.5)
-    if (incremental_potential(m, dt, unknowns, unknown_of, springs, step_dx, alpha) <= phi0 + 1e-12 * std::fabs(phi0))
+    if (incremental_potential(m, dt, unknowns, unknown_of, springs, step_dx, alpha) <=
+        phi0 + 1e-12 * std::fabs(phi0))
       break;
   return alpha;
 }

@@ -77,7 +77,9 @@ void precompute(const Membrane& m, double dt, ImplicitCache& c) {
   c.predictor_k.clear();
   std::vector<Sym3> diag(nu);
   for (size_t u = 0; u < nu; ++u) {
-    const double m_u = implicit_detail::mass_scale(d) / p.inv_mass[c.predictor_unknowns[u]] * (1.0 + dt * drag) + dt2 * glue_k;
+    const double m_u =
+        implicit_detail::mass_scale(d) / p.inv_mass[c.predictor_unknowns[u]] * (1.0 + dt * drag) +
+        dt2 * glue_k;
     diag[u] = {m_u, 0.0, 0.0, m_u, 0.0, m_u};
   }
   std::vector<Eigen::Triplet<double>> triplets;
@@ -86,7 +88,8 @@ void precompute(const Membrane& m, double dt, ImplicitCache& c) {
     const uint32_t i = s.i[e], j = s.j[e];
     const uint32_t ui = c.predictor_unknown_of[i], uj = c.predictor_unknown_of[j];
     if (ui == kNotUnknown && uj == kNotUnknown) continue;
-    const double dx = double(p.x[j]) - p.x[i], dy = double(p.y[j]) - p.y[i], dz = double(p.z[j]) - p.z[i];
+    const double dx = double(p.x[j]) - p.x[i], dy = double(p.y[j]) - p.y[i],
+                 dz = double(p.z[j]) - p.z[i];
     Sym3 h;
     if (isotropic) {
       double k = s.stiffness[e];
@@ -122,7 +125,8 @@ void precompute(const Membrane& m, double dt, ImplicitCache& c) {
       continue;
     }
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) triplets.emplace_back(int(3 * u + a), int(3 * u + b), sym_at(diag[u], a, b));
+      for (int b = 0; b < 3; ++b)
+        triplets.emplace_back(int(3 * u + a), int(3 * u + b), sym_at(diag[u], a, b));
   }
   const Eigen::Index size = static_cast<Eigen::Index>(isotropic ? nu : 3 * nu);
   Eigen::SparseMatrix<double> a(size, size);
@@ -130,7 +134,8 @@ void precompute(const Membrane& m, double dt, ImplicitCache& c) {
   if (nu > 0) {
     c.predictor_factor->compute(a);
     if (c.predictor_factor->info() != Eigen::Success)
-      throw std::runtime_error("implicit predictor: the frozen system is not positive definite (check masses)");
+      throw std::runtime_error(
+          "implicit predictor: the frozen system is not positive definite (check masses)");
   }
   c.predictor_force.resize(static_cast<Eigen::Index>(3 * nu));
   c.predictor_rhs.resize(static_cast<Eigen::Index>(3 * nu));
@@ -173,7 +178,10 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
     const double mass = implicit_detail::mass_scale(d) * true_mass;
     const double v[3] = {p.vx[i], p.vy[i], p.vz[i]}, x[3] = {p.x[i], p.y[i], p.z[i]};
     for (int a = 0; a < 3; ++a) {
-      const double rest = glued ? (a == 0 ? m.glue->x[i] : a == 1 ? m.glue->y[i] : m.glue->z[i]) : x[a];
+      const double rest = glued ? (a == 0   ? m.glue->x[i]
+                                   : a == 1 ? m.glue->y[i]
+                                            : m.glue->z[i])
+                                : x[a];
       f[3 * u + a] = true_mass * d.gravity_mm_s2[a] - mass * drag * v[a] - glue_k * (x[a] - rest);
       hv[3 * u + a] = glue_k * v[a];
     }
@@ -182,12 +190,14 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
   for (size_t t = 0; t < c.predictor_springs.size(); ++t) {
     const uint32_t e = c.predictor_springs[t], i = s.i[e], j = s.j[e];
     const uint32_t ui = c.predictor_unknown_of[i], uj = c.predictor_unknown_of[j];
-    const double dx = double(p.x[j]) - p.x[i], dy = double(p.y[j]) - p.y[i], dz = double(p.z[j]) - p.z[i];
+    const double dx = double(p.x[j]) - p.x[i], dy = double(p.y[j]) - p.y[i],
+                 dz = double(p.z[j]) - p.z[i];
     const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
     double fi[3] = {0.0, 0.0, 0.0};
     if (l > 0.0) {
       const double ext = l - s.rest_length[e];
-      const double mag = d.law == SpringLaw::Linear ? s.stiffness[e] * ext : s.stiffness[e] * ext * std::fabs(ext);
+      const double mag =
+          d.law == SpringLaw::Linear ? s.stiffness[e] * ext : s.stiffness[e] * ext * std::fabs(ext);
       fi[0] = mag * dx / l, fi[1] = mag * dy / l, fi[2] = mag * dz / l;
     }
     double vi[3], vj[3];
@@ -195,7 +205,8 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
     filter_velocity(p, j, uj != kNotUnknown, vj);
     const Sym3& h = c.predictor_k[t];
     const double w[3] = {vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2]};
-    const double hw[3] = {h[0] * w[0] + h[1] * w[1] + h[2] * w[2], h[1] * w[0] + h[3] * w[1] + h[4] * w[2],
+    const double hw[3] = {h[0] * w[0] + h[1] * w[1] + h[2] * w[2],
+                          h[1] * w[0] + h[3] * w[1] + h[4] * w[2],
                           h[2] * w[0] + h[4] * w[1] + h[5] * w[2]};
     for (int a = 0; a < 3; ++a) {
       if (ui != kNotUnknown) f[3 * ui + a] += fi[a], hv[3 * ui + a] += hw[a];
@@ -219,10 +230,12 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
     const uint32_t i = c.predictor_unknowns[u];
     const bool moves = !restricted || std::binary_search(m.active.begin(), m.active.end(), i);
     const double v[3] = {p.vx[i], p.vy[i], p.vz[i]};
-    for (int a = 0; a < 3; ++a) c.predictor_dx[3 * u + a] = moves ? dt * (v[a] + c.predictor_dv[3 * u + a]) : 0.0;
+    for (int a = 0; a < 3; ++a)
+      c.predictor_dx[3 * u + a] = moves ? dt * (v[a] + c.predictor_dv[3 * u + a]) : 0.0;
   }
-  const double alpha = implicit_detail::line_search(m, dt, c.settings.max_line_search_halvings, c.predictor_unknowns,
-                                                    c.predictor_unknown_of, c.predictor_springs, c.predictor_dx.data());
+  const double alpha = implicit_detail::line_search(m, dt, c.settings.max_line_search_halvings,
+                                                    c.predictor_unknowns, c.predictor_unknown_of,
+                                                    c.predictor_springs, c.predictor_dx.data());
   c.stats.step_fraction = alpha;
   if (alpha < 1.0) ++c.stats.line_search_cuts;
 
@@ -230,8 +243,10 @@ void implicit_predictor_step(Membrane& m, double dt, ImplicitCache& c) {
   for (size_t u = 0; u < nu; ++u) {
     const uint32_t i = c.predictor_unknowns[u];
     if (restricted && !std::binary_search(m.active.begin(), m.active.end(), i)) continue;
-    const double dx = alpha * c.predictor_dx[3 * u], dy = alpha * c.predictor_dx[3 * u + 1], dz = alpha * c.predictor_dx[3 * u + 2];
-    p.vx[i] = static_cast<float>(dx / dt), p.vy[i] = static_cast<float>(dy / dt), p.vz[i] = static_cast<float>(dz / dt);
+    const double dx = alpha * c.predictor_dx[3 * u], dy = alpha * c.predictor_dx[3 * u + 1],
+                 dz = alpha * c.predictor_dx[3 * u + 2];
+    p.vx[i] = static_cast<float>(dx / dt), p.vy[i] = static_cast<float>(dy / dt),
+    p.vz[i] = static_cast<float>(dz / dt);
     p.x[i] = static_cast<float>(p.x[i] + dx);
     p.y[i] = static_cast<float>(p.y[i] + dy);
     p.z[i] = static_cast<float>(p.z[i] + dz);

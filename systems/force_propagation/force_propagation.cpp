@@ -40,8 +40,8 @@ NodeState node_state(const Particles& p, const Springs& s, SpringLaw law, const 
 }
 
 // One local Newton step at node i; returns the length of the move, mm.
-double relax_node(Particles& p, const Springs& s, SpringLaw law, const SpringGraph& g,
-                  uint32_t i, const Eigen::Vector3d& external, double omega) {
+double relax_node(Particles& p, const Springs& s, SpringLaw law, const SpringGraph& g, uint32_t i,
+                  const Eigen::Vector3d& external, double omega) {
   NodeState st = node_state(p, s, law, g, i);
   st.force += external;
   const double trace = st.k.trace();

@@ -4,7 +4,8 @@
 
 namespace phaco::grasp {
 
-uint32_t nearest_particle(const Particles& p, const Vec3& tip, double radius_mm, ParticleKind kind) {
+uint32_t nearest_particle(const Particles& p, const Vec3& tip, double radius_mm,
+                          ParticleKind kind) {
   uint32_t best = kInvalidIndex;
   double best_d2 = radius_mm * radius_mm;
   for (uint32_t i = 0; i < p.slots.size(); ++i) {

@@ -28,7 +28,8 @@ struct GraspState {
   bool holding() const { return particle != kInvalidIndex; }
 };
 
-// Nearest particle of the given kind within radius of `tip`, or kInvalidIndex (lowest index on ties).
+// Nearest particle of the given kind within radius of `tip`, or kInvalidIndex (lowest index on
+// ties).
 uint32_t nearest_particle(const Particles& p, const Vec3& tip, double radius_mm,
                           ParticleKind kind = ParticleKind::Free);
 

@@ -18,13 +18,18 @@ Vec3 radial(const Vec3& p) {
 
 }  // namespace
 
-std::string_view to_string(TearRule r) { return r == TearRule::FlapForce ? "flap_force" : "most_stressed_spring"; }
+std::string_view to_string(TearRule r) {
+  return r == TearRule::FlapForce ? "flap_force" : "most_stressed_spring";
+}
 
 std::string_view to_string(TearEvent::Kind k) {
   switch (k) {
-    case TearEvent::RunoutWarning: return "runout_warning";
-    case TearEvent::RadialTearout: return "radial_tearout";
-    default: return "completed";
+    case TearEvent::RunoutWarning:
+      return "runout_warning";
+    case TearEvent::RadialTearout:
+      return "radial_tearout";
+    default:
+      return "completed";
   }
 }
 
@@ -37,7 +42,8 @@ double tear_resistance_mn(double tear_energy_j_m2, double thickness_mm) {
 }
 
 uint32_t TearState::count(TearEvent::Kind k) const {
-  return static_cast<uint32_t>(std::count_if(events.begin(), events.end(), [k](const TearEvent& e) { return e.kind == k; }));
+  return static_cast<uint32_t>(
+      std::count_if(events.begin(), events.end(), [k](const TearEvent& e) { return e.kind == k; }));
 }
 
 RunoutCheck check_runout(const Vec3& tip, const Vec3& direction, const TearSettings& s) {
@@ -54,7 +60,8 @@ RunoutCheck check_runout(const Vec3& tip, const Vec3& direction, const TearSetti
   } else {
     c.distance_to_safe_edge_mm = -pd + std::sqrt(pd * pd - (pp - R * R));  // |p + s·d| = R, s > 0
   }
-  c.warn = c.outward_angle_deg > s.warn_angle_deg || c.distance_to_safe_edge_mm < s.warn_lookahead_mm;
+  c.warn =
+      c.outward_angle_deg > s.warn_angle_deg || c.distance_to_safe_edge_mm < s.warn_lookahead_mm;
   return c;
 }
 
@@ -99,7 +106,9 @@ uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const Tea
       const auto it = m.topology.spring_of_edge.find(cut::edge_key(tip, n));
       if (it == m.topology.spring_of_edge.end()) continue;
       const double rest = m.springs.rest_length[it->second];
-      const double len = (cut::particle_position(m.particles, n) - cut::particle_position(m.particles, tip)).norm();
+      const double len =
+          (cut::particle_position(m.particles, n) - cut::particle_position(m.particles, tip))
+              .norm();
       if (rest <= 0 || (len - rest) / rest <= s.break_strain) continue;
       const double force = m.springs.stiffness[it->second] * (len - rest);
       if (force > best_force || (force == best_force && n < best)) best_force = force, best = n;
@@ -108,11 +117,13 @@ uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const Tea
   return best;
 }
 
-TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, const Vec3& flap_force,
-                         const TearSettings& tear, const cut::CutSettings& cut, cut::EditLog& log) {
+TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state,
+                         const Vec3& flap_force, const TearSettings& tear,
+                         const cut::CutSettings& cut, cut::EditLog& log) {
   if (path.tip == kInvalidIndex || !m.particles.slots.alive(path.tip))
     throw std::invalid_argument("tear_step: the path has no tip (puncture and cut a flap first)");
-  if (!flap_force.allFinite()) throw std::invalid_argument("tear_step: the flap force is not finite");
+  if (!flap_force.allFinite())
+    throw std::invalid_argument("tear_step: the flap force is not finite");
   TearStepReport r;
   if (state.complete || path.reached_boundary) return r;
   ++state.steps;
@@ -137,7 +148,8 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, 
   }
   const RunoutCheck check = check_runout(x, target - x, tear);
   if (check.warn && state.warning_armed) {
-    state.events.push_back({TearEvent::RunoutWarning, state.steps, std::hypot(x.x(), x.y()), check.outward_angle_deg, x});
+    state.events.push_back({TearEvent::RunoutWarning, state.steps, std::hypot(x.x(), x.y()),
+                            check.outward_angle_deg, x});
     state.warning_armed = false;
     r.warned = true;
   } else if (!check.warn) {
@@ -148,20 +160,23 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, 
     r.advanced = true;
     ++state.advances;
     const Vec3 now = cut::particle_position(m.particles, path.tip);
-    if ((now - state.front).norm() <= cut.snap.vertex_snap_mm || tear.rule != TearRule::FlapForce) state.front = now;
+    if ((now - state.front).norm() <= cut.snap.vertex_snap_mm || tear.rule != TearRule::FlapForce)
+      state.front = now;
     const double radius = std::hypot(now.x(), now.y());
     state.max_radius_mm = std::max(state.max_radius_mm, radius);
     if (radius > tear.safe_radius_mm && !state.torn_out) {
       state.torn_out = true;
       r.torn_out = true;
-      state.events.push_back({TearEvent::RadialTearout, state.steps, radius, check.outward_angle_deg, now});
+      state.events.push_back(
+          {TearEvent::RadialTearout, state.steps, radius, check.outward_angle_deg, now});
     }
   }
   if (r.segment.reached_boundary) {
     state.complete = true;
     r.completed = true;
     const Vec3 now = cut::particle_position(m.particles, path.tip);
-    state.events.push_back({TearEvent::Completed, state.steps, std::hypot(now.x(), now.y()), check.outward_angle_deg, now});
+    state.events.push_back({TearEvent::Completed, state.steps, std::hypot(now.x(), now.y()),
+                            check.outward_angle_deg, now});
   }
   return r;
 }

@@ -55,11 +55,12 @@ std::string_view to_string(TearRule r);
 
 struct TearSettings {
   TearRule rule = TearRule::FlapForce;
-  double threshold_mn = 10.0;       // |f_t| needed to tear (flap-force rule): the resistance F_c
-  double a_mm_per_mn = 0.01;        // seed 000's a
-  double b_mm = 0.05;               // seed 000's b
-  double max_step_mm = 0.15;        // cap on one step's length
-  double break_strain = 0.29;       // over-extension that breaks a spring (elongation at break, DESIGN §6)
+  double threshold_mn = 10.0;  // |f_t| needed to tear (flap-force rule): the resistance F_c
+  double a_mm_per_mn = 0.01;   // seed 000's a
+  double b_mm = 0.05;          // seed 000's b
+  double max_step_mm = 0.15;   // cap on one step's length
+  double break_strain =
+      0.29;  // over-extension that breaks a spring (elongation at break, DESIGN §6)
   double outward_bias = 0.0;        // anterior bowing: outward push per unit of |f_t| step
   double safe_radius_mm = 3.5;      // the tear must stay inside this circle about the optical axis
   double warn_angle_deg = 30.0;     // outward turn that warns
@@ -74,22 +75,22 @@ double tear_resistance_mn(double tear_energy_j_m2, double thickness_mm);
 
 struct TearEvent {
   enum Kind : uint8_t { RunoutWarning, RadialTearout, Completed } kind;
-  uint64_t step;              // tear step index
-  double radius_mm;           // tip distance from the optical axis
-  double outward_angle_deg;   // of the tear direction, positive outward
+  uint64_t step;             // tear step index
+  double radius_mm;          // tip distance from the optical axis
+  double outward_angle_deg;  // of the tear direction, positive outward
   Vec3 at;
 };
 std::string_view to_string(TearEvent::Kind k);
 
 struct TearState {
-  uint64_t steps = 0;            // tear steps attempted
-  uint64_t advances = 0;         // steps that moved the tear
-  bool warning_armed = true;     // a new warning may be raised
-  bool torn_out = false;         // a runaway radial tear happened
-  bool complete = false;         // the tear met the rim or the cut it started from
+  uint64_t steps = 0;         // tear steps attempted
+  uint64_t advances = 0;      // steps that moved the tear
+  bool warning_armed = true;  // a new warning may be raised
+  bool torn_out = false;      // a runaway radial tear happened
+  bool complete = false;      // the tear met the rim or the cut it started from
   double max_radius_mm = 0.0;
-  Vec3 front = Vec3::Zero();     // where the flap-force rule has taken the tear (the tip follows
-  bool front_valid = false;      // it when snapping lets it)
+  Vec3 front = Vec3::Zero();  // where the flap-force rule has taken the tear (the tip follows
+  bool front_valid = false;   // it when snapping lets it)
   std::vector<TearEvent> events;
   uint32_t count(TearEvent::Kind k) const;
 };
@@ -125,8 +126,9 @@ struct TearStepReport {
 
 // One tear step from the path's tip (the path must have one: tearing continues a cut). Throws
 // std::invalid_argument for a path without a tip or a non-finite force.
-TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state, const Vec3& flap_force,
-                         const TearSettings& tear, const cut::CutSettings& cut, cut::EditLog& log);
+TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state,
+                         const Vec3& flap_force, const TearSettings& tear,
+                         const cut::CutSettings& cut, cut::EditLog& log);
 
 // The tear as the force limit: tear steps while the flap force, relaxed by the advance so far
 // (F' = F·(1 − Δ/e), e the flap's elongation, mm), stays at or above the threshold, up to

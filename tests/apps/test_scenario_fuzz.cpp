@@ -9,7 +9,8 @@
 // Deterministic by seed: PHACO_FUZZ_SEED (default below) and PHACO_FUZZ_COUNT override; mutation
 // i draws from its own generator (seed, i), so one failure reproduces alone. Each mutation is run
 // at eye level 0 for at most 1 s simulated and kMaxFrames steps, so that the few thousand cases fit
-// the CI budget (90 s in Release on two busy cores); most die in validation, which costs microseconds.
+// the CI budget (90 s in Release on two busy cores); most die in validation, which costs
+// microseconds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,9 +23,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <numeric>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <string>
@@ -39,8 +40,8 @@
 #include "procedures/scene/run.hpp"
 #include "procedures/scene/scene.hpp"
 #include "procedures/scene/scene_inputs.hpp"
-#include "tests/support/sanitizers.hpp"
 #include "tests/support/particle_checks.hpp"
+#include "tests/support/sanitizers.hpp"
 
 namespace phaco {
 namespace {
@@ -55,7 +56,7 @@ constexpr uint64_t kDefaultSeed = 20261126;
 // mutation.
 const int kDefaultCount = test::asan_scaled(2400, 5);
 constexpr double kMaxSimulatedS = 1.0;
-constexpr uint64_t kMaxFrames = 60;  // 0.5 s at the shipped 1/120 s
+constexpr uint64_t kMaxFrames = 60;              // 0.5 s at the shipped 1/120 s
 constexpr double kTeleportSpeedMmPerS = 10'000;  // 10 m/s
 // Replaced, in the dumped text, by a token JSON cannot hold as a value (1e999, NaN).
 constexpr const char* kTextSentinel = "@@fuzz-text@@";

@@ -2,7 +2,6 @@
 // the plain SoA step is bit-identical for 1 and 2 threads and sags under a load, the hot tables
 // stay within the byte budgets, and the Bullet peer mirrors the mesh and stays finite.
 #include <gtest/gtest.h>
-
 #include <oneapi/tbb/task_arena.h>
 
 #include <cmath>

@@ -1,14 +1,12 @@
 // perf/report: CSV/JSON writing and RESULTS.md assembly in a fixed order from the sections present.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <sstream>
-
-#include <unistd.h>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "perf/report.hpp"
 
@@ -39,7 +37,8 @@ TEST(Report, CsvAndJsonCarryEveryCell) {
   EXPECT_THROW(t.add({1.0}), std::invalid_argument);
   write_csv(t, dir.path / "t.csv");
   write_json(t, dir.path / "t.json");
-  EXPECT_EQ(slurp(dir.path / "t.csv"), "method,ns,note\nplain step,7.5,\"a, \"\"quoted\"\" note\"\nnan,,\n");
+  EXPECT_EQ(slurp(dir.path / "t.csv"),
+            "method,ns,note\nplain step,7.5,\"a, \"\"quoted\"\" note\"\nnan,,\n");
   const auto j = nlohmann::json::parse(slurp(dir.path / "t.json"));
   ASSERT_EQ(j.size(), 2u);
   EXPECT_EQ(j[0]["method"], "plain step");
@@ -53,8 +52,8 @@ TEST(Report, ResultsAssembledInFixedOrderKeepingOtherSections) {
   write_section(dir.path, "zeta", "## Zeta\n");
   write_section(dir.path, "foundation", "## Foundation\n\nf\n");
   const std::string md = assemble_results(dir.path, "| CPU | x |\n");
-  const size_t machine = md.find("## Machine"), f = md.find("## Foundation"), m = md.find("## Membrane"),
-               z = md.find("## Zeta");
+  const size_t machine = md.find("## Machine"), f = md.find("## Foundation"),
+               m = md.find("## Membrane"), z = md.find("## Zeta");
   ASSERT_NE(machine, std::string::npos);
   ASSERT_NE(f, std::string::npos);
   ASSERT_NE(m, std::string::npos);

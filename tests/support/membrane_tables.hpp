@@ -9,6 +9,8 @@ inline Particles particles_from(const SurfaceMesh& mesh, float inv_mass = 1.0f) 
   return particles_at(mesh.vertices, ParticleKind::Free, inv_mass);
 }
 
-inline Triangles triangles_from(const SurfaceMesh& mesh) { return triangles_of(mesh); }
+inline Triangles triangles_from(const SurfaceMesh& mesh) {
+  return triangles_of(mesh);
+}
 
 }  // namespace phaco::test

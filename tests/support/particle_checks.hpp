@@ -20,7 +20,8 @@ inline bool all_finite(const Particles& p) {
 // Bit-exact hash of positions and velocities, for determinism checks.
 inline uint64_t hash_state(const Particles& p) {
   StateHash h;
-  for (const std::vector<float>* col : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz}) h.add(std::span<const float>(*col));
+  for (const std::vector<float>* col : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz})
+    h.add(std::span<const float>(*col));
   return h.value();
 }
 

@@ -104,7 +104,7 @@ TEST(Handle, StaleHandleIsDetected) {
 TEST(Handle, GenerationFollowsElementThroughCompaction) {
   Points p = make_points(3);
   table_remove(p, 0);
-  table_add(p);     // slot 0 reused, generation 1
+  table_add(p);  // slot 0 reused, generation 1
   table_remove(p, 1);
   const uint32_t gen_of_2 = p.slots.generation(2);
   table_compact(p);

@@ -1,11 +1,11 @@
-// engine/plot/chart: renders real pixels, maps log axes by decades, fits power laws exactly, and survives
-// bad input (NaN, empty series, non-positive values on a log axis) by skipping and reporting.
+// engine/plot/chart: renders real pixels, maps log axes by decades, fits power laws exactly, and
+// survives bad input (NaN, empty series, non-positive values on a log axis) by skipping and
+// reporting.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <limits>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "engine/plot/chart.hpp"
@@ -84,7 +84,8 @@ TEST(Chart, LogRangeWidensToWholeDecadesAndTicksAreDecades) {
   EXPECT_DOUBLE_EQ(range->second, 10000.0);
   const std::vector<double> ticks = axis_ticks(range->first, range->second, Scale::Log10);
   ASSERT_EQ(ticks.size(), 5u);
-  for (size_t i = 0; i < ticks.size(); ++i) EXPECT_NEAR(ticks[i], std::pow(10.0, double(i)), 1e-9 * ticks[i]);
+  for (size_t i = 0; i < ticks.size(); ++i)
+    EXPECT_NEAR(ticks[i], std::pow(10.0, double(i)), 1e-9 * ticks[i]);
   // Under two decades, 2 and 5 are ticked too.
   const std::vector<double> minor = axis_ticks(1.0, 10.0, Scale::Log10);
   EXPECT_EQ(minor, (std::vector<double>{1.0, 2.0, 5.0, 10.0}));
@@ -94,7 +95,8 @@ TEST(Chart, LinearTicksAreNiceSteps) {
   const std::vector<double> ticks = axis_ticks(0.0, 2.5, Scale::Linear);
   ASSERT_GE(ticks.size(), 3u);
   const double step = ticks[1] - ticks[0];
-  EXPECT_TRUE(std::fabs(step - 0.5) < 1e-12 || std::fabs(step - 0.2) < 1e-12 || std::fabs(step - 1.0) < 1e-12);
+  EXPECT_TRUE(std::fabs(step - 0.5) < 1e-12 || std::fabs(step - 0.2) < 1e-12 ||
+              std::fabs(step - 1.0) < 1e-12);
   EXPECT_DOUBLE_EQ(ticks.front(), 0.0);
 }
 
@@ -111,18 +113,21 @@ TEST(Chart, PowerLawFitOfExactDataIsExact) {
 
 TEST(Chart, PowerLawFitSkipsUnusablePointsAndNeedsTwo) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<double> x = {10, 100, -5, nan, 1000}, y = {2, 4, 3, 1, 8};  // slope log10(2) on usable points
+  const std::vector<double> x = {10, 100, -5, nan, 1000},
+                            y = {2, 4, 3, 1, 8};  // slope log10(2) on usable points
   const PowerFit fit = fit_power_law(x, y);
   ASSERT_TRUE(fit.ok);
   EXPECT_EQ(fit.points, 3u);
   EXPECT_NEAR(fit.slope, std::log10(2.0), 1e-12);
   EXPECT_FALSE(fit_power_law(std::vector<double>{5}, std::vector<double>{1}).ok);
-  EXPECT_FALSE(fit_power_law(std::vector<double>{5, 5}, std::vector<double>{1, 2}).ok);  // no x spread
+  EXPECT_FALSE(
+      fit_power_law(std::vector<double>{5, 5}, std::vector<double>{1, 2}).ok);  // no x spread
   EXPECT_FALSE(fit_power_law(std::vector<double>{}, std::vector<double>{}).ok);
 }
 
 TEST(Chart, BadInputIsSkippedAndReportedNeverCrashes) {
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN(),
+               inf = std::numeric_limits<double>::infinity();
   Chart c = two_series();
   c.series.push_back({"bad", {nan, 1e4, -1, 0, inf}, {1, nan, 5, 5, 5}});
   c.series.push_back({"empty"});
@@ -134,9 +139,9 @@ TEST(Chart, BadInputIsSkippedAndReportedNeverCrashes) {
   RenderReport report;
   cv::Mat img;
   ASSERT_NO_THROW(img = render_chart(c, &report));
-  EXPECT_EQ(report.points_skipped, 5u);      // every point of "bad"
+  EXPECT_EQ(report.points_skipped, 5u);        // every point of "bad"
   EXPECT_EQ(report.points_drawn, 6u + 1 + 1);  // two_series, ragged's first, the one-point series
-  EXPECT_GE(report.warnings.size(), 5u);     // bad, empty, ragged, one-point fit, marker
+  EXPECT_GE(report.warnings.size(), 5u);       // bad, empty, ragged, one-point fit, marker
   EXPECT_FALSE(img.empty());
 
   // All-NaN chart on log axes: frame only, reported.

@@ -19,8 +19,8 @@ inline SessionRecord sample_record(const std::string& trainee, const std::string
   r.metrics = {{"rhexis.diameter_mm", 5.25}, {"rhexis.complete", true}, {"score", score}};
   r.score = score;
   r.state_hash = "0123456789abcdef";
-  r.recording = {{"drill", "capsulorhexis"}, {"dt_s", 1.0 / 120.0},
-                 {"hands", nlohmann::json::object()}};
+  r.recording = {
+      {"drill", "capsulorhexis"}, {"dt_s", 1.0 / 120.0}, {"hands", nlohmann::json::object()}};
   r.report = {{"state_hash", "0123456789abcdef"}, {"frames", 10}};
   return r;
 }

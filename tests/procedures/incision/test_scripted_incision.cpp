@@ -15,10 +15,10 @@
 #include <tuple>
 #include <type_traits>
 
-#include "tests/support/expect_invalid.hpp"
 #include "engine/core/state_hash.hpp"
 #include "procedures/incision/cornea_sheet.hpp"
 #include "procedures/incision/scripted_incision.hpp"
+#include "tests/support/expect_invalid.hpp"
 #include "tests/systems/cut/cut_sheet.hpp"
 
 namespace phaco::corneal_incision {

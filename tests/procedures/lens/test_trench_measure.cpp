@@ -12,15 +12,16 @@ const NucleusShape kNucleus{3.29, 1.26, -1.89};
 
 // A band of removed cubes (0.05 mm) along `angle_deg` through the origin: `width` across,
 // `length` along, from the nucleus's anterior surface down to depth `depth` below it.
-void add_band(std::vector<RemovedElement>& out, double angle_deg, double width, double length, double depth,
-              uint32_t stroke, Vec3 offset = Vec3::Zero()) {
+void add_band(std::vector<RemovedElement>& out, double angle_deg, double width, double length,
+              double depth, uint32_t stroke, Vec3 offset = Vec3::Zero()) {
   const double h = 0.05, a = angle_deg * M_PI / 180.0;
   const Vec3 u(std::cos(a), std::sin(a), 0), n(-std::sin(a), std::cos(a), 0);
   for (double s = -length / 2 + h / 2; s < length / 2; s += h) {
     for (double w = -width / 2 + h / 2; w < width / 2; w += h) {
       const Vec3 p = offset + s * u + w * n;
       const double top = nucleus_anterior_z(kNucleus, p.x(), p.y());
-      for (double z = top - h / 2; z > top - depth; z -= h) out.push_back({Vec3(p.x(), p.y(), z), h * h * h, stroke});
+      for (double z = top - h / 2; z > top - depth; z -= h)
+        out.push_back({Vec3(p.x(), p.y(), z), h * h * h, stroke});
     }
   }
 }
@@ -61,7 +62,8 @@ TEST(TrenchMeasure, TouchesBelowTheMinimumVolumeAreNotTrenches) {
   const TrenchReport r = measure_trenches(removed, kNucleus);
   ASSERT_EQ(r.trenches.size(), 1u);
   EXPECT_EQ(r.crossing_angle_deg, 0.0);
-  EXPECT_GT(r.volume_removed_mm3, r.trenches[0].volume_mm3);  // the touch still counts as removed volume
+  EXPECT_GT(r.volume_removed_mm3,
+            r.trenches[0].volume_mm3);  // the touch still counts as removed volume
 }
 
 TEST(TrenchMeasure, RejectsANucleusWithoutThickness) {

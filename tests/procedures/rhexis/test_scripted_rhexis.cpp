@@ -24,15 +24,17 @@ cut::CutSettings cut_settings() {
   return s;
 }
 
-class IdealRhexis : public ::testing::TestWithParam<std::tuple<int, eye::CapsuleLayout, tear::TearRule>> {};
+class IdealRhexis
+    : public ::testing::TestWithParam<std::tuple<int, eye::CapsuleLayout, tear::TearRule>> {};
 
 TEST_P(IdealRhexis, ClosesARoundOpeningOfTheTargetDiameter) {
   const auto [level, layout, rule] = GetParam();
-  cut::test::CutSheet sheet =
-      cut::test::cut_sheet(eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout));
+  cut::test::CutSheet sheet = cut::test::cut_sheet(
+      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout));
   // The capsule's rim is held (anchored) as in the scene.
   for (uint32_t v = 0; v < sheet.particles.slots.size(); ++v)
-    if (std::hypot(sheet.particles.x[v], sheet.particles.y[v]) > 0.999 * 4.5) sheet.particles.kind[v] = ParticleKind::Anchored;
+    if (std::hypot(sheet.particles.x[v], sheet.particles.y[v]) > 0.999 * 4.5)
+      sheet.particles.kind[v] = ParticleKind::Anchored;
   cut::CutMesh m = sheet.mesh();
   tear::TearSettings tear;
   tear.rule = rule;
@@ -52,12 +54,14 @@ TEST_P(IdealRhexis, ClosesARoundOpeningOfTheTargetDiameter) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Capsule, IdealRhexis,
-                         ::testing::Values(std::make_tuple(3, eye::CapsuleLayout::Curvilinear, tear::TearRule::FlapForce),
-                                           std::make_tuple(3, eye::CapsuleLayout::Isotropic, tear::TearRule::FlapForce)));
+                         ::testing::Values(std::make_tuple(3, eye::CapsuleLayout::Curvilinear,
+                                                           tear::TearRule::FlapForce),
+                                           std::make_tuple(3, eye::CapsuleLayout::Isotropic,
+                                                           tear::TearRule::FlapForce)));
 
 TEST(OutwardPull, WarnsBeforeTheTearLeavesTheSafeZoneAndRecordsTheTearOut) {
-  cut::test::CutSheet sheet = cut::test::cut_sheet(
-      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(3), eye::CapsuleLayout::Curvilinear));
+  cut::test::CutSheet sheet = cut::test::cut_sheet(eye::make_capsule(
+      eye::default_eye_params(), eye::resolution_for_level(3), eye::CapsuleLayout::Curvilinear));
   cut::CutMesh m = sheet.mesh();
   RhexisScript script;
   script.pull = RhexisScript::Pull::Outward;
@@ -66,7 +70,8 @@ TEST(OutwardPull, WarnsBeforeTheTearLeavesTheSafeZoneAndRecordsTheTearOut) {
   RecordProperty("first_warning_radius_mm", std::to_string(r.first_warning_radius_mm));
   ASSERT_GE(r.runout_warnings, 1u);
   EXPECT_GT(r.first_warning_radius_mm, 0.0);
-  EXPECT_LT(r.first_warning_radius_mm, tear.safe_radius_mm) << "the warning comes before the tear leaves the zone";
+  EXPECT_LT(r.first_warning_radius_mm, tear.safe_radius_mm)
+      << "the warning comes before the tear leaves the zone";
   EXPECT_EQ(r.radial_tearouts, 1u) << "the runaway radial tear is recorded, once";
   EXPECT_GT(r.tearout_radius_mm, tear.safe_radius_mm);
   EXPECT_FALSE(r.opening.complete);
@@ -79,10 +84,11 @@ class StraightCut : public ::testing::TestWithParam<std::tuple<int, eye::Capsule
 
 TEST_P(StraightCut, FollowsTheToolWithinTheSnapDistance) {
   const auto [level, layout] = GetParam();
-  cut::test::CutSheet sheet =
-      cut::test::cut_sheet(eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout));
+  cut::test::CutSheet sheet = cut::test::cut_sheet(
+      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout));
   for (uint32_t v = 0; v < sheet.particles.slots.size(); ++v)
-    if (std::hypot(sheet.particles.x[v], sheet.particles.y[v]) > 0.999 * 4.5) sheet.particles.kind[v] = ParticleKind::Anchored;
+    if (std::hypot(sheet.particles.x[v], sheet.particles.y[v]) > 0.999 * 4.5)
+      sheet.particles.kind[v] = ParticleKind::Anchored;
   cut::CutMesh m = sheet.mesh();
   const cut::CutSettings settings = cut_settings();
   cut::CutPath path;
@@ -99,7 +105,8 @@ TEST_P(StraightCut, FollowsTheToolWithinTheSnapDistance) {
   EXPECT_LE(f.cut_to_tool_mm, path.max_snap_mm + 1e-3);
   // The far way round samples the lips at ends and midpoints: half the longest lip of slack.
   EXPECT_LE(f.tool_to_cut_mm, path.max_snap_mm + 0.2);
-  EXPECT_LT((cut::particle_position(sheet.particles, path.tip) - tool.back()).norm(), 0.1) << "the cut reached the end";
+  EXPECT_LT((cut::particle_position(sheet.particles, path.tip) - tool.back()).norm(), 0.1)
+      << "the cut reached the end";
   EXPECT_TRUE(cut::test::sound(sheet));
 }
 
@@ -109,8 +116,8 @@ INSTANTIATE_TEST_SUITE_P(Capsule, StraightCut,
                                                               eye::CapsuleLayout::Isotropic)));
 
 TEST(ScriptedRhexis, RefusesABadScript) {
-  cut::test::CutSheet sheet = cut::test::cut_sheet(
-      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(0), eye::CapsuleLayout::Curvilinear));
+  cut::test::CutSheet sheet = cut::test::cut_sheet(eye::make_capsule(
+      eye::default_eye_params(), eye::resolution_for_level(0), eye::CapsuleLayout::Curvilinear));
   cut::CutMesh m = sheet.mesh();
   RhexisScript script;
   script.radius_mm = -1.0;

@@ -64,15 +64,16 @@ TEST(TearForce, TheExpertTearsAtThePlateauWithAnRmsInTheExpertBand) {
   EXPECT_DOUBLE_EQ(peak, e.max);
   EXPECT_LE(peak, (1 + kPlateauMargin) * e.resistance_mn) << "no ramp above the tear resistance";
   // Nor once the tear has closed and the forceps still hold the freed disc (the whole run).
-  EXPECT_LE(e.metrics.value("left.contact_force_mN.max", 1e9), (1 + kPlateauMargin) * e.resistance_mn);
+  EXPECT_LE(e.metrics.value("left.contact_force_mN.max", 1e9),
+            (1 + kPlateauMargin) * e.resistance_mn);
 }
 
 TEST(TearForce, TheNovicesTearAtTheSamePlateau) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "whole drills take minutes under ASan; the Release pass runs them";
 #endif
-  for (const char* file : {"capsulorhexis_novice_off_centre.json", "capsulorhexis_novice_runout.json",
-                           "capsulorhexis_novice_small.json"}) {
+  for (const char* file : {"capsulorhexis_novice_off_centre.json",
+                           "capsulorhexis_novice_runout.json", "capsulorhexis_novice_small.json"}) {
     const TearForce n = measure(file);
     ASSERT_FALSE(n.force.empty()) << file;
     EXPECT_GT(n.tearing_s, 3.0) << file;

@@ -30,7 +30,8 @@ Grid make_grid(int n, bool king) {
   Grid g{n};
   table_append(g.particles, static_cast<uint32_t>(n * n));
   for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) g.particles.x[g.at(r, c)] = float(c), g.particles.y[g.at(r, c)] = float(r);
+    for (int c = 0; c < n; ++c)
+      g.particles.x[g.at(r, c)] = float(c), g.particles.y[g.at(r, c)] = float(r);
   auto link = [&](uint32_t a, uint32_t b) {
     const uint32_t e = table_add(g.springs);
     g.springs.i[e] = std::min(a, b), g.springs.j[e] = std::max(a, b);
@@ -58,8 +59,8 @@ size_t ball(const Grid& g, std::vector<uint32_t> seeds, uint32_t k) {
 TEST(ActiveNodes, KHopBallsOnGridsHaveTheExactSize) {
   const Grid four = make_grid(31, false), eight = make_grid(31, true);
   for (uint32_t k = 0; k <= 7; ++k) {
-    EXPECT_EQ(ball(four, {four.at(15, 15)}, k), 2 * k * k + 2 * k + 1) << k;    // diamond
-    EXPECT_EQ(ball(four, {four.at(0, 0)}, k), (k + 1) * (k + 2) / 2) << k;      // corner: a quarter
+    EXPECT_EQ(ball(four, {four.at(15, 15)}, k), 2 * k * k + 2 * k + 1) << k;  // diamond
+    EXPECT_EQ(ball(four, {four.at(0, 0)}, k), (k + 1) * (k + 2) / 2) << k;    // corner: a quarter
     EXPECT_EQ(ball(eight, {eight.at(15, 15)}, k), (2 * k + 1) * (2 * k + 1)) << k;  // square
   }
   // Seed 003: k = 5 → 120 nodes on its curvilinear mesh; the 8-neighbour grid gives 121.
@@ -85,7 +86,8 @@ TEST(ActiveNodes, OutputsAreSortedAndTheSpringsAreThoseWithAnActiveEnd) {
   const uint32_t seeds[] = {g.at(3, 20), g.at(12, 12)};
   active_nodes::update_active_set(g.graph, seeds, 3, {}, set);
   EXPECT_TRUE(std::is_sorted(set.particles.begin(), set.particles.end()));
-  EXPECT_TRUE(std::adjacent_find(set.particles.begin(), set.particles.end()) == set.particles.end());
+  EXPECT_TRUE(std::adjacent_find(set.particles.begin(), set.particles.end()) ==
+              set.particles.end());
   std::vector<uint32_t> expected;
   for (uint32_t e = 0; e < g.springs.slots.size(); ++e) {
     const bool a = std::binary_search(set.particles.begin(), set.particles.end(), g.springs.i[e]);
@@ -106,7 +108,8 @@ TEST(ActiveNodes, NeighbourMotionWakesAndQuietParticlesFallAsleep) {
   g.particles.vx[g.at(10, 11)] = 0.2f;  // mm/s × 0.01 s
   WakeInputs wake{.particles = &g.particles, .dt_s = 0.01, .motion_threshold_mm = 1e-3};
   active_nodes::update_active_set(g.graph, {}, 1, wake, set);
-  const std::vector<uint32_t> expected = {g.at(9, 11), g.at(10, 10), g.at(10, 11), g.at(10, 12), g.at(11, 11)};
+  const std::vector<uint32_t> expected = {g.at(9, 11), g.at(10, 10), g.at(10, 11), g.at(10, 12),
+                                          g.at(11, 11)};
   EXPECT_EQ(set.particles, expected);
   EXPECT_EQ(set.woken, 5u);
   const std::vector<uint32_t> asleep = {g.at(9, 10), g.at(10, 9), g.at(11, 10)};
@@ -125,7 +128,8 @@ TEST(ActiveNodes, ForceOnTheSleepingFrontierWakesIt) {
   ActiveSet set;
   const uint32_t seed[] = {g.at(10, 10)};
   active_nodes::update_active_set(g.graph, seed, 1, {}, set);
-  WakeInputs wake{.particles = &g.particles, .dt_s = 0.01, .springs = &g.springs, .force_threshold_mn = 0.05};
+  WakeInputs wake{
+      .particles = &g.particles, .dt_s = 0.01, .springs = &g.springs, .force_threshold_mn = 0.05};
 
   // At rest every spring is slack: nothing wakes beyond the ball.
   active_nodes::update_active_set(g.graph, seed, 1, wake, set);
@@ -163,7 +167,10 @@ TEST(ActiveNodes, DeterministicAndAllocationFreeAfterWarmUp) {
   const uint32_t* particles = reused.particles.data();
   const uint32_t* springs_data = reused.springs.data();
   const size_t capacity = reused.springs.capacity();
-  for (int s = 0; s < 4; ++s) active_nodes::update_active_set(g.graph, s % 2 ? std::span<const uint32_t>(a) : std::span<const uint32_t>(b), 6, {}, reused);
+  for (int s = 0; s < 4; ++s)
+    active_nodes::update_active_set(
+        g.graph, s % 2 ? std::span<const uint32_t>(a) : std::span<const uint32_t>(b), 6, {},
+        reused);
   EXPECT_EQ(reused.particles.data(), particles);
   EXPECT_EQ(reused.springs.data(), springs_data);
   EXPECT_EQ(reused.springs.capacity(), capacity);
@@ -171,13 +178,14 @@ TEST(ActiveNodes, DeterministicAndAllocationFreeAfterWarmUp) {
 
 TEST(ActiveNodes, FiveHopsOnTheCapsuleMatchSeed003) {
   // Level 1 has about 2000 vertices, as seed 003's mesh (2005).
-  const SurfaceMesh mesh = eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(1),
-                                             eye::CapsuleLayout::Curvilinear);
+  const SurfaceMesh mesh = eye::make_capsule(
+      eye::default_eye_params(), eye::resolution_for_level(1), eye::CapsuleLayout::Curvilinear);
   Particles p;
   Triangles t;
   table_append(p, static_cast<uint32_t>(mesh.vertices.size()));
   for (size_t i = 0; i < mesh.vertices.size(); ++i)
-    p.x[i] = float(mesh.vertices[i].x()), p.y[i] = float(mesh.vertices[i].y()), p.z[i] = float(mesh.vertices[i].z());
+    p.x[i] = float(mesh.vertices[i].x()), p.y[i] = float(mesh.vertices[i].y()),
+    p.z[i] = float(mesh.vertices[i].z());
   table_append(t, static_cast<uint32_t>(mesh.triangles.size()));
   for (size_t i = 0; i < mesh.triangles.size(); ++i)
     t.a[i] = mesh.triangles[i][0], t.b[i] = mesh.triangles[i][1], t.c[i] = mesh.triangles[i][2];
@@ -201,9 +209,12 @@ TEST(ActiveNodes, FiveHopsOnTheCapsuleMatchSeed003) {
     smallest = std::min(smallest, set.particles.size());
     largest = std::max(largest, set.particles.size());
   }
-  std::printf("[ figures  ] capsule level 1 (%zu vertices): 5-hop sets of %zu to %zu nodes (seed 003: 120 of 2005)\n",
-              mesh.vertices.size(), smallest, largest);
-  // Interior valence 4 or 8: the ball lies between the 4-neighbour diamond and the 8-neighbour square.
+  std::printf(
+      "[ figures  ] capsule level 1 (%zu vertices): 5-hop sets of %zu to %zu nodes (seed 003: 120 "
+      "of 2005)\n",
+      mesh.vertices.size(), smallest, largest);
+  // Interior valence 4 or 8: the ball lies between the 4-neighbour diamond and the 8-neighbour
+  // square.
   EXPECT_GE(smallest, 61u);
   EXPECT_LE(largest, 121u);
 }

@@ -34,7 +34,8 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
   const auto [level, layout, full_paths] = GetParam();
   // Levels 2 and 3 run a fifth of their paths under ASan (tests/support/sanitizers.hpp).
   const int paths = level >= 2 ? phaco::test::asan_scaled(full_paths, 5) : full_paths;
-  const SurfaceMesh mesh = eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout);
+  const SurfaceMesh mesh =
+      eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level), layout);
   double radius = 0.0;
   for (const auto& v : mesh.vertices) radius = std::max(radius, std::hypot(v.x(), v.y()));
   // Mean edge length sets the scale of lengths and speeds.
@@ -59,7 +60,8 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
     }
     CutMesh m = sheet.mesh();
     auto u = [&](uint32_t draw) { return rng.uniform_double(static_cast<uint64_t>(p), draw, 0); };
-    const int style = static_cast<int>(u(0) * 5);  // 0 straight, 1 through vertices, 2 along edges, 3 curving, 4 off the rim
+    const int style = static_cast<int>(
+        u(0) * 5);  // 0 straight, 1 through vertices, 2 along edges, 3 curving, 4 off the rim
     const double length = (0.2 + 6.0 * u(1)) * edge * (style == 4 ? 30.0 : 1.0);
     const double speed = (0.15 + 2.5 * u(2)) * edge;  // mm between samples
     const double heading = 2.0 * 3.14159265358979 * u(3);
@@ -71,8 +73,10 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
     if (style == 1 || style == 2) {
       // Start at a vertex and aim at another vertex (style 1) or run along a chain of edges
       // (style 2, by stepping from vertex to neighbouring vertex).
-      uint32_t v = static_cast<uint32_t>(u(7) * sheet.particles.slots.size()) % sheet.particles.slots.size();
-      for (int tries = 0; tries < 8 && !sheet.particles.slots.alive(v); ++tries) v = (v + 1) % sheet.particles.slots.size();
+      uint32_t v =
+          static_cast<uint32_t>(u(7) * sheet.particles.slots.size()) % sheet.particles.slots.size();
+      for (int tries = 0; tries < 8 && !sheet.particles.slots.alive(v); ++tries)
+        v = (v + 1) % sheet.particles.slots.size();
       if (!sheet.particles.slots.alive(v)) continue;
       samples.push_back(particle_position(sheet.particles, v));
       const int hops = 1 + static_cast<int>(u(8) * 6);
@@ -82,11 +86,13 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
         if (!sheet.triangles.slots.alive(hint)) break;
         vertex_fan(sheet.triangles, sheet.topology.adjacency, hint, v, fan);
         const uint32_t t = fan[static_cast<size_t>(u(9 + h) * fan.size()) % fan.size()];
-        const uint32_t next = corner(sheet.triangles, t, (corner_slot(sheet.triangles, t, v) + 1 + (h & 1)) % 3);
+        const uint32_t next =
+            corner(sheet.triangles, t, (corner_slot(sheet.triangles, t, v) + 1 + (h & 1)) % 3);
         if (style == 1) {
           samples.push_back(particle_position(sheet.particles, next));
         } else {
-          const Vec3 a = particle_position(sheet.particles, v), b = particle_position(sheet.particles, next);
+          const Vec3 a = particle_position(sheet.particles, v),
+                     b = particle_position(sheet.particles, next);
           for (double f : {0.25, 0.5, 0.75, 1.0}) samples.push_back(a + f * (b - a));
         }
         v = next;
@@ -106,8 +112,9 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
       // Lift the sample onto the capsule's dome so the tool point is near the surface.
       Vec3 tool = q;
       tool.z() = 5.0;
-      const CutPoint c = locate_cut_point(sheet.particles, sheet.triangles, sheet.topology.adjacency,
-                                          path.hint_triangle, tool, settings.snap);
+      const CutPoint c =
+          locate_cut_point(sheet.particles, sheet.triangles, sheet.topology.adjacency,
+                           path.hint_triangle, tool, settings.snap);
       tool = Vec3(q.x(), q.y(), c.position.z() + 0.01 * edge);
       ++totals.samples;
       const SegmentReport r = cut_towards(m, path, tool, settings, log);
@@ -129,7 +136,9 @@ TEST_P(CutFuzz, RandomPathsNeverBreakTheMembrane) {
   EXPECT_EQ(totals.paths, static_cast<uint64_t>(paths));
   EXPECT_GT(totals.segments, static_cast<uint64_t>(paths));
   EXPECT_GT(totals.through_rim, 0u);
-  for (int c = 0; c < kCutCases; ++c) RecordProperty(std::string(to_string(static_cast<CutCase>(c))), std::to_string(totals.cases[c]));
+  for (int c = 0; c < kCutCases; ++c)
+    RecordProperty(std::string(to_string(static_cast<CutCase>(c))),
+                   std::to_string(totals.cases[c]));
   RecordProperty("segments", std::to_string(totals.segments));
 }
 
@@ -147,7 +156,8 @@ INSTANTIATE_TEST_SUITE_P(
                       std::make_tuple(3, eye::CapsuleLayout::Isotropic, 750)),
     [](const auto& info) {
       return "level" + std::to_string(std::get<0>(info.param)) +
-             (std::get<1>(info.param) == eye::CapsuleLayout::Curvilinear ? "_curvilinear" : "_isotropic");
+             (std::get<1>(info.param) == eye::CapsuleLayout::Curvilinear ? "_curvilinear"
+                                                                         : "_isotropic");
     });
 
 }  // namespace

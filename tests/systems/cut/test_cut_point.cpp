@@ -6,11 +6,11 @@
 #include <stdexcept>
 #include <vector>
 
-#include "tests/support/grid_mesh.hpp"
-#include "tests/support/membrane_tables.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/cut/cut_point.hpp"
 #include "systems/cut/segment_trace.hpp"
+#include "tests/support/grid_mesh.hpp"
+#include "tests/support/membrane_tables.hpp"
 
 namespace phaco::cut {
 namespace {
@@ -30,7 +30,9 @@ Sheet from_mesh(const SurfaceMesh& mesh) {
 }
 
 // The unit grid of tests/support/grid_mesh.hpp.
-Sheet grid(int n, double jitter) { return from_mesh(test::grid_mesh(n, jitter)); }
+Sheet grid(int n, double jitter) {
+  return from_mesh(test::grid_mesh(n, jitter));
+}
 
 Vec3 pos(const Sheet& s, uint32_t v) {
   return particle_position(s.particles, v);

@@ -14,8 +14,8 @@
 namespace phaco::cut {
 namespace {
 
-using test::CutSheet;
 using test::cut_sheet;
+using test::CutSheet;
 using test::sound;
 
 CutSettings settings() {
@@ -26,7 +26,9 @@ CutSettings settings() {
   return s;
 }
 
-Vec3 P(double x, double y) { return {x, y, 0.0}; }
+Vec3 P(double x, double y) {
+  return {x, y, 0.0};
+}
 
 // The live particle nearest to x (and its distance).
 uint32_t nearest(const CutSheet& s, const Vec3& x, double* d = nullptr) {
@@ -47,7 +49,7 @@ struct CanonicalCase {
   CutCase expected;
   uint32_t new_points;  // inserted cut points
   uint32_t spanned;
-  uint32_t copies;      // the path's inner vertices, one copy each; its two ends are crack tips
+  uint32_t copies;  // the path's inner vertices, one copy each; its two ends are crack tips
 };
 
 class Canonical : public ::testing::TestWithParam<CanonicalCase> {};
@@ -81,16 +83,17 @@ TEST_P(Canonical, InitialCutMakesTheCaseTheTableNames) {
 
 INSTANTIATE_TEST_SUITE_P(
     Table1, Canonical,
-    ::testing::Values(CanonicalCase{"face-face", P(1.55, 1.2), P(1.85, 1.5), CutCase::IC1, 2, 1, 0},
-                      CanonicalCase{"edge-edge", P(1.5, 1.0), P(1.6, 1.6), CutCase::IC2, 2, 1, 0},
-                      CanonicalCase{"vertex-vertex along an edge", P(1, 1), P(2, 2), CutCase::IC3, 0, 1, 0},
-                      CanonicalCase{"vertex-vertex across two", P(1, 2), P(2, 1), CutCase::IC3, 1, 2, 1},
-                      CanonicalCase{"face-edge", P(1.6, 1.3), P(2.0, 1.5), CutCase::IC4, 2, 1, 0},
-                      CanonicalCase{"edge-face", P(2.0, 1.5), P(1.7, 1.25), CutCase::IC4, 2, 1, 0},
-                      CanonicalCase{"face-vertex", P(1.6, 1.3), P(2, 1), CutCase::IC5, 1, 1, 0},
-                      CanonicalCase{"vertex-face", P(2, 1), P(1.6, 1.3), CutCase::IC5, 1, 1, 0},
-                      CanonicalCase{"edge-vertex", P(1.5, 1.0), P(2, 2), CutCase::IC6, 1, 1, 0},
-                      CanonicalCase{"face-face across two", P(1.7, 1.2), P(1.2, 1.6), CutCase::IC1, 3, 2, 1}),
+    ::testing::Values(
+        CanonicalCase{"face-face", P(1.55, 1.2), P(1.85, 1.5), CutCase::IC1, 2, 1, 0},
+        CanonicalCase{"edge-edge", P(1.5, 1.0), P(1.6, 1.6), CutCase::IC2, 2, 1, 0},
+        CanonicalCase{"vertex-vertex along an edge", P(1, 1), P(2, 2), CutCase::IC3, 0, 1, 0},
+        CanonicalCase{"vertex-vertex across two", P(1, 2), P(2, 1), CutCase::IC3, 1, 2, 1},
+        CanonicalCase{"face-edge", P(1.6, 1.3), P(2.0, 1.5), CutCase::IC4, 2, 1, 0},
+        CanonicalCase{"edge-face", P(2.0, 1.5), P(1.7, 1.25), CutCase::IC4, 2, 1, 0},
+        CanonicalCase{"face-vertex", P(1.6, 1.3), P(2, 1), CutCase::IC5, 1, 1, 0},
+        CanonicalCase{"vertex-face", P(2, 1), P(1.6, 1.3), CutCase::IC5, 1, 1, 0},
+        CanonicalCase{"edge-vertex", P(1.5, 1.0), P(2, 2), CutCase::IC6, 1, 1, 0},
+        CanonicalCase{"face-face across two", P(1.7, 1.2), P(1.2, 1.6), CutCase::IC1, 3, 2, 1}),
     [](const auto& info) {
       std::string n = info.param.name;
       for (char& ch : n)
@@ -109,15 +112,16 @@ std::vector<std::pair<Vec3, Vec3>> cut_lip_edges(const CutSheet& s, double n) {
                  w = particle_position(s.particles, corner(s.triangles, t, (k + 1) % 3));
       bool rim = false;
       for (int axis = 0; axis < 2; ++axis)
-        for (double side : {0.0, n - 1})
-          rim = rim || (u[axis] == side && w[axis] == side);
+        for (double side : {0.0, n - 1}) rim = rim || (u[axis] == side && w[axis] == side);
       if (!rim) out.emplace_back(u, w);
     }
   }
   return out;
 }
 
-uint32_t cut_boundary_edges(const CutSheet& s, double n) { return static_cast<uint32_t>(cut_lip_edges(s, n).size()); }
+uint32_t cut_boundary_edges(const CutSheet& s, double n) {
+  return static_cast<uint32_t>(cut_lip_edges(s, n).size());
+}
 
 TEST(ProgressiveCut, SubsequentCutsDuplicateTheCurrentCutPointAndSplitItsSprings) {
   CutSheet s = cut_sheet(phaco::test::grid_mesh(6, 0.0));
@@ -187,11 +191,13 @@ TEST(ProgressiveCut, ACutReachingTheRimSeparatesItAndEndsThePath) {
   CutPath path;
   EditLog log;
   cut_towards(m, path, P(2.4, 2.3), settings(), log);
-  for (double x = 2.0; x > -0.5; x -= 0.4) cut_towards(m, path, P(x, 2.3 + 0.1 * (2.4 - x)), settings(), log);
+  for (double x = 2.0; x > -0.5; x -= 0.4)
+    cut_towards(m, path, P(x, 2.3 + 0.1 * (2.4 - x)), settings(), log);
   EXPECT_TRUE(path.reached_boundary);
   EXPECT_TRUE(sound(s));
   const uint32_t live = s.particles.slots.live_count();
-  EXPECT_TRUE(cut_towards(m, path, P(3.5, 3.5), settings(), log).reached_boundary) << "ignored until end_cut";
+  EXPECT_TRUE(cut_towards(m, path, P(3.5, 3.5), settings(), log).reached_boundary)
+      << "ignored until end_cut";
   EXPECT_EQ(s.particles.slots.live_count(), live);
   end_cut(path);
   cut_towards(m, path, P(3.3, 3.4), settings(), log);
@@ -212,7 +218,8 @@ TEST(ProgressiveCut, PrestretchedSpringsPullTheLipsApart) {
   std::vector<Vec3> force(s.particles.slots.size(), Vec3::Zero());
   for (uint32_t e = 0; e < s.springs.slots.size(); ++e) {
     if (!s.springs.slots.alive(e)) continue;
-    const Vec3 d = particle_position(s.particles, s.springs.j[e]) - particle_position(s.particles, s.springs.i[e]);
+    const Vec3 d = particle_position(s.particles, s.springs.j[e]) -
+                   particle_position(s.particles, s.springs.i[e]);
     const Vec3 f = s.springs.stiffness[e] * (d.norm() - s.springs.rest_length[e]) * d.normalized();
     force[s.springs.i[e]] += f;
     force[s.springs.j[e]] -= f;
@@ -227,7 +234,8 @@ TEST(ProgressiveCut, PrestretchedSpringsPullTheLipsApart) {
     vertex_fan(s.triangles, s.topology.adjacency, s.topology.vertex_triangle[v], v, fan);
     Vec3 centroid = Vec3::Zero();
     for (uint32_t t : fan)
-      for (int k = 0; k < 3; ++k) centroid += particle_position(s.particles, corner(s.triangles, t, k)) / (3.0 * fan.size());
+      for (int k = 0; k < 3; ++k)
+        centroid += particle_position(s.particles, corner(s.triangles, t, k)) / (3.0 * fan.size());
     const double side = (centroid - particle_position(s.particles, v)).dot(across);
     ++lips;
     opening += force[v].dot(across) * side > 0;
@@ -258,7 +266,8 @@ double to_polyline(const Vec3& x, const std::vector<Vec3>& line) {
   double best = 1e300;
   for (size_t k = 0; k + 1 < line.size(); ++k) {
     const Vec3 e = line[k + 1] - line[k];
-    const double t = e.squaredNorm() > 0 ? std::clamp((x - line[k]).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+    const double t =
+        e.squaredNorm() > 0 ? std::clamp((x - line[k]).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
     best = std::min(best, (x - (line[k] + t * e)).norm());
   }
   return best;
@@ -337,7 +346,8 @@ TEST(ProgressiveCut, BadInputIsRefusedWithoutChangingTheMesh) {
   const double nan = std::nan("");
   EXPECT_THROW(cut_towards(m, path, P(nan, 1.0), settings(), log), std::invalid_argument);
   cut_towards(m, path, P(1.2, 1.3), settings(), log);
-  EXPECT_THROW(cut_towards(m, path, Vec3(1.0, 1.0, INFINITY), settings(), log), std::invalid_argument);
+  EXPECT_THROW(cut_towards(m, path, Vec3(1.0, 1.0, INFINITY), settings(), log),
+               std::invalid_argument);
   EXPECT_EQ(s.particles.slots.live_count(), 16u);
   EXPECT_THROW(split_edge(m, 0, 15, 0.5, log), std::invalid_argument) << "not an edge";
   EXPECT_THROW(split_edge(m, 0, 1, 1.0, log), std::invalid_argument) << "t outside (0, 1)";

@@ -5,10 +5,10 @@
 #include <cstring>
 #include <vector>
 
-#include "tests/support/particle_checks.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/deform/deform.hpp"
 #include "systems/springs/springs.hpp"
+#include "tests/support/particle_checks.hpp"
 
 namespace phaco::deform_test {
 
@@ -146,7 +146,6 @@ inline uint32_t centre_particle(const Body& b) {
 
 using test::all_finite;
 using test::hash_state;
-
 
 inline double max_speed(const Particles& p) {
   double s = 0.0;

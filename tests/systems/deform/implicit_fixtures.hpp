@@ -5,10 +5,10 @@
 #include <cstring>
 #include <vector>
 
-#include "tests/support/particle_checks.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/deform/implicit.hpp"
 #include "systems/springs/springs.hpp"
+#include "tests/support/particle_checks.hpp"
 
 namespace phaco::implicit_test {
 
@@ -38,7 +38,8 @@ inline void finish(Body& b, const springs::SpringMaterial& material) {
 
 // n × n nodes, `spacing` apart, centred on the origin in z = 0; each square split by a diagonal;
 // rim anchored, interior free with mass `mass_kg`. Node (r, c) is r·n + c.
-inline Body make_grid(int n, double spacing, double mass_kg, const springs::SpringMaterial& material) {
+inline Body make_grid(int n, double spacing, double mass_kg,
+                      const springs::SpringMaterial& material) {
   Body b;
   table_append(b.particles, static_cast<uint32_t>(n * n));
   const double half = 0.5 * (n - 1) * spacing;
@@ -55,7 +56,8 @@ inline Body make_grid(int n, double spacing, double mass_kg, const springs::Spri
   for (int r = 0; r + 1 < n; ++r)
     for (int c = 0; c + 1 < n; ++c) {
       const uint32_t v00 = r * n + c, v01 = v00 + 1, v10 = v00 + n, v11 = v10 + 1;
-      for (auto [a, bb, cc] : {std::array<uint32_t, 3>{v00, v01, v11}, std::array<uint32_t, 3>{v00, v11, v10}}) {
+      for (auto [a, bb, cc] :
+           {std::array<uint32_t, 3>{v00, v01, v11}, std::array<uint32_t, 3>{v00, v11, v10}}) {
         const uint32_t t = table_add(b.triangles);
         b.triangles.a[t] = a, b.triangles.b[t] = bb, b.triangles.c[t] = cc;
       }
@@ -66,8 +68,8 @@ inline Body make_grid(int n, double spacing, double mass_kg, const springs::Spri
 
 // The anterior capsule at `level`, rim anchored, lumped mass ρ·h·A/3 per triangle corner.
 inline Body make_capsule(int level, double youngs_kpa = 2000.0, double prestretch = 0.0) {
-  const SurfaceMesh mesh = eye::make_capsule(eye::default_eye_params(), eye::resolution_for_level(level),
-                                             eye::CapsuleLayout::Curvilinear);
+  const SurfaceMesh mesh = eye::make_capsule(
+      eye::default_eye_params(), eye::resolution_for_level(level), eye::CapsuleLayout::Curvilinear);
   Body b;
   const uint32_t n = static_cast<uint32_t>(mesh.vertices.size());
   table_append(b.particles, n);
@@ -77,8 +79,9 @@ inline Body make_capsule(int level, double youngs_kpa = 2000.0, double prestretc
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
     b.triangles.a[t] = tri[0], b.triangles.b[t] = tri[1], b.triangles.c[t] = tri[2];
-    const double area =
-        0.5 * (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]).norm();
+    const double area = 0.5 * (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
+                                  .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]])
+                                  .norm();
     for (uint32_t v : tri) mass[v] += kDensityKgMm3 * kThicknessMm * area / 3.0;
   }
   for (uint32_t i = 0; i < n; ++i) {
@@ -86,7 +89,8 @@ inline Body make_capsule(int level, double youngs_kpa = 2000.0, double prestretc
     b.particles.y[i] = static_cast<float>(mesh.vertices[i].y());
     b.particles.z[i] = static_cast<float>(mesh.vertices[i].z());
   }
-  springs::SpringMaterial material{.sheet_modulus_mn_mm = youngs_kpa * kThicknessMm, .prestretch = prestretch};
+  springs::SpringMaterial material{.sheet_modulus_mn_mm = youngs_kpa * kThicknessMm,
+                                   .prestretch = prestretch};
   finish(b, material);
   // Rim: vertices of edges used by one triangle only.
   std::vector<int> count(b.springs.slots.size(), 0);
@@ -98,8 +102,10 @@ inline Body make_capsule(int level, double youngs_kpa = 2000.0, double prestretc
       uint32_t lo = 0, hi = b.springs.slots.size();
       while (lo < hi) {
         const uint32_t mid = (lo + hi) / 2;
-        if (b.springs.i[mid] < a || (b.springs.i[mid] == a && b.springs.j[mid] < c)) lo = mid + 1;
-        else hi = mid;
+        if (b.springs.i[mid] < a || (b.springs.i[mid] == a && b.springs.j[mid] < c))
+          lo = mid + 1;
+        else
+          hi = mid;
       }
       ++count[lo];
     }
@@ -120,7 +126,8 @@ inline double total_energy(const Body& b) {
   for (uint32_t i = 0; i < p.slots.size(); ++i) {
     if (p.inv_mass[i] <= 0.0f) continue;
     const double m = 1.0 / p.inv_mass[i];
-    e += 0.5 * m * (double(p.vx[i]) * p.vx[i] + double(p.vy[i]) * p.vy[i] + double(p.vz[i]) * p.vz[i]);
+    e += 0.5 * m *
+         (double(p.vx[i]) * p.vx[i] + double(p.vy[i]) * p.vy[i] + double(p.vz[i]) * p.vz[i]);
     e -= m * (b.dynamics.gravity_mm_s2[0] * p.x[i] + b.dynamics.gravity_mm_s2[1] * p.y[i] +
               b.dynamics.gravity_mm_s2[2] * p.z[i]);
   }
@@ -129,6 +136,5 @@ inline double total_energy(const Body& b) {
 
 using test::all_finite;
 using test::hash_state;
-
 
 }  // namespace phaco::implicit_test

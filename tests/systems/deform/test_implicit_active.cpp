@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "systems/springs/springs.hpp"
 #include "systems/active_nodes/active_nodes.hpp"
+#include "systems/springs/springs.hpp"
 #include "tests/systems/deform/implicit_fixtures.hpp"
 
 namespace phaco {
@@ -19,7 +19,9 @@ using implicit_test::make_grid;
 
 constexpr double kFrameStep = 1.0 / 120.0;
 
-uint32_t centre(int n) { return static_cast<uint32_t>((n / 2) * n + n / 2); }
+uint32_t centre(int n) {
+  return static_cast<uint32_t>((n / 2) * n + n / 2);
+}
 
 // The centre node grasped (scripted) and pulled up at 10 mm/s; the set is its k-hop ball.
 void grasp_centre(Body& b, int n, uint32_t hops) {
@@ -44,7 +46,9 @@ void step(Body& b, double dt, ImplicitCache& cache, int n) {
 
 // A moderately stiff patch (k·dt²/m ≈ 1 at dt = 1/120 s): an implicit step's response to a local
 // pull decays over a few hops, so a 5-hop set holds nearly all of it.
-Body soft_patch(int n) { return make_grid(n, 0.2, 5e-5, {.sheet_modulus_mn_mm = 0.5, .prestretch = 0.05}); }
+Body soft_patch(int n) {
+  return make_grid(n, 0.2, 5e-5, {.sheet_modulus_mn_mm = 0.5, .prestretch = 0.05});
+}
 
 TEST(ImplicitActiveSet, SleepingParticlesStayAndTheSetMatchesTheFullStep) {
   const int n = 31;
@@ -71,11 +75,14 @@ TEST(ImplicitActiveSet, SleepingParticlesStayAndTheSetMatchesTheFullStep) {
       continue;
     }
     max_motion = std::max(max_motion, std::fabs(dz_full));
-    max_difference = std::max(max_difference, std::fabs(double(local.particles.z[i]) - full.particles.z[i]));
+    max_difference =
+        std::max(max_difference, std::fabs(double(local.particles.z[i]) - full.particles.z[i]));
   }
-  std::printf("[ figures  ] 5-hop set of %zu: max motion %.4g mm, max difference to the full step %.3g mm "
-              "(%.2f %%); full-step motion outside the set %.3g mm\n",
-              local.active.size(), max_motion, max_difference, 100 * max_difference / max_motion, outside_full);
+  std::printf(
+      "[ figures  ] 5-hop set of %zu: max motion %.4g mm, max difference to the full step %.3g mm "
+      "(%.2f %%); full-step motion outside the set %.3g mm\n",
+      local.active.size(), max_motion, max_difference, 100 * max_difference / max_motion,
+      outside_full);
   EXPECT_GT(max_motion, 0.05);
   EXPECT_LT(max_difference, 0.03 * max_motion);
 }
@@ -101,9 +108,10 @@ TEST(ImplicitActiveSet, WorkFollowsTheSetNotTheMesh) {
   auto m = whole.membrane();
   deform::implicit_euler_step(m, kFrameStep, whole_cache);
   EXPECT_EQ(whole_cache.stats.unknowns, 79u * 79u);
-  std::printf("[ figures  ] 81×81 patch: %u unknowns / %llu nonzeros with a 5-hop set, %u / %llu without\n",
-              large_cache.stats.unknowns, static_cast<unsigned long long>(large_cache.stats.nonzeros),
-              whole_cache.stats.unknowns, static_cast<unsigned long long>(whole_cache.stats.nonzeros));
+  std::printf(
+      "[ figures  ] 81×81 patch: %u unknowns / %llu nonzeros with a 5-hop set, %u / %llu without\n",
+      large_cache.stats.unknowns, static_cast<unsigned long long>(large_cache.stats.nonzeros),
+      whole_cache.stats.unknowns, static_cast<unsigned long long>(whole_cache.stats.nonzeros));
 }
 
 TEST(ImplicitActiveSet, PatternIsBuiltOncePerSet) {
@@ -140,8 +148,9 @@ TEST(ImplicitEuler, WarmStartReducesIterations) {
   const int second = warm.stats.cg_iterations;
   b.particles = state;
   deform::implicit_euler_step(m, kFrameStep, cold);
-  std::printf("[ figures  ] CG iterations: first solve %d, same step warm-started %d, from zero %d\n", first, second,
-              cold.stats.cg_iterations);
+  std::printf(
+      "[ figures  ] CG iterations: first solve %d, same step warm-started %d, from zero %d\n",
+      first, second, cold.stats.cg_iterations);
   EXPECT_GT(first, 5);
   EXPECT_LT(second, cold.stats.cg_iterations);
   EXPECT_LE(second, 1);
@@ -158,7 +167,8 @@ TEST(ImplicitEuler, AssembledAndMatrixFreeOperatorsAgree) {
   for (int s = 0; s < 4; ++s) step(a, kFrameStep, ca, n), step(f, kFrameStep, cf, n);
   EXPECT_EQ(ca.stats.cg_iterations > 0, true);
   double worst = 0.0;
-  for (uint32_t i = 0; i < a.particles.slots.size(); ++i) worst = std::max(worst, double(std::fabs(a.particles.z[i] - f.particles.z[i])));
+  for (uint32_t i = 0; i < a.particles.slots.size(); ++i)
+    worst = std::max(worst, double(std::fabs(a.particles.z[i] - f.particles.z[i])));
   EXPECT_LT(worst, 1e-5);
 }
 

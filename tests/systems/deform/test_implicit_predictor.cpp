@@ -35,15 +35,18 @@ TEST(ImplicitPredictor, StableAtFrameStepWithCapsuleMaterial) {
       energy = e;
     }
     double max_speed = 0.0;
-    for (uint32_t i = 0; i < b.particles.slots.size(); ++i) max_speed = std::max(max_speed, double(std::fabs(b.particles.vz[i])));
+    for (uint32_t i = 0; i < b.particles.slots.size(); ++i)
+      max_speed = std::max(max_speed, double(std::fabs(b.particles.vz[i])));
     EXPECT_LT(max_speed, 1.0) << "the kick has died out";
     EXPECT_EQ(cache.stats.precomputations, 1u);
   }
 }
 
 // A patch whose centre is lifted by `pull_mm` and released: the largest difference between the
-// predictor's and implicit Euler's z over 30 frames; `relaxed` gets implicit Euler's final centre z.
-double predictor_vs_implicit(double pull_mm, deform::PredictorStiffness stiffness, double* relaxed) {
+// predictor's and implicit Euler's z over 30 frames; `relaxed` gets implicit Euler's final centre
+// z.
+double predictor_vs_implicit(double pull_mm, deform::PredictorStiffness stiffness,
+                             double* relaxed) {
   const int n = 21;
   const uint32_t g = (n / 2) * n + n / 2;
   Body bodies[2] = {make_grid(n, 0.2, 5e-5, {.sheet_modulus_mn_mm = 0.5, .prestretch = 0.05}),
@@ -59,7 +62,8 @@ double predictor_vs_implicit(double pull_mm, deform::PredictorStiffness stiffnes
     auto m1 = bodies[1].membrane();
     deform::implicit_predictor_step(m1, kFrameStep, caches[1]);
     for (uint32_t i = 0; i < bodies[0].particles.slots.size(); ++i)
-      worst = std::max(worst, double(std::fabs(bodies[0].particles.z[i] - bodies[1].particles.z[i])));
+      worst =
+          std::max(worst, double(std::fabs(bodies[0].particles.z[i] - bodies[1].particles.z[i])));
   }
   *relaxed = bodies[0].particles.z[g];
   return worst;
@@ -68,11 +72,16 @@ double predictor_vs_implicit(double pull_mm, deform::PredictorStiffness stiffnes
 TEST(ImplicitPredictor, MatchesImplicitEulerForSmallDisplacements) {
   for (double pull : {0.002, 0.02}) {
     double relaxed = 0.0;
-    const double frozen = predictor_vs_implicit(pull, deform::PredictorStiffness::FrozenJacobian, &relaxed);
-    const double isotropic = predictor_vs_implicit(pull, deform::PredictorStiffness::Isotropic, &relaxed);
-    std::printf("[ figures  ] pull %.3g mm released: implicit Euler's centre at %.3g mm after 30 frames; largest "
-                "difference to it: frozen Jacobian %.3g mm (%.2f %% of the pull), isotropic %.3g mm (%.1f %%)\n",
-                pull, relaxed, frozen, 100 * frozen / pull, isotropic, 100 * isotropic / pull);
+    const double frozen =
+        predictor_vs_implicit(pull, deform::PredictorStiffness::FrozenJacobian, &relaxed);
+    const double isotropic =
+        predictor_vs_implicit(pull, deform::PredictorStiffness::Isotropic, &relaxed);
+    std::printf(
+        "[ figures  ] pull %.3g mm released: implicit Euler's centre at %.3g mm after 30 frames; "
+        "largest "
+        "difference to it: frozen Jacobian %.3g mm (%.2f %% of the pull), isotropic %.3g mm (%.1f "
+        "%%)\n",
+        pull, relaxed, frozen, 100 * frozen / pull, isotropic, 100 * isotropic / pull);
     EXPECT_LT(relaxed, 0.5 * pull);  // the pull did relax: the comparison covers real motion
     EXPECT_LT(frozen, (pull < 0.01 ? 0.01 : 0.1) * pull);
     EXPECT_GT(isotropic, 5 * frozen);  // the isotropic filter lags out of plane (see implicit.hpp)

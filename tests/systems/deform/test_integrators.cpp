@@ -233,7 +233,6 @@ TEST(ActiveSet, OnlyActiveParticlesMove) {
   }
 }
 
-
 // Every integrator reaches the same static equilibrium under gravity and a point load, with mass
 // scaling changing only inertia: the residual of the true forces (weight of the true mass, the
 // load, the springs) vanishes at rest. Guards against an integrator that drops the loads or weighs
@@ -242,8 +241,8 @@ TEST(ActiveSet, OnlyActiveParticlesMove) {
 // glue included) and a few iterations per step leave a residual of about a quarter of the load
 // (measured 0.005 mN of 0.02; docs/dynamics.md).
 TEST(Equilibrium, PointLoadAndTrueWeightReachedByEveryStableIntegrator) {
-  for (const Integrator integrator : {Integrator::ImplicitEuler, Integrator::ImplicitPredictor,
-                                      Integrator::SemiImplicit001}) {
+  for (const Integrator integrator :
+       {Integrator::ImplicitEuler, Integrator::ImplicitPredictor, Integrator::SemiImplicit001}) {
     Body b = deform_test::make_grid(9, 0.5, 1e-6, {.sheet_modulus_mn_mm = 1.0, .prestretch = 0.05});
     b.dynamics.integrator = integrator;
     b.dynamics.mass_scale = 50.0f;
@@ -265,7 +264,8 @@ TEST(Equilibrium, PointLoadAndTrueWeightReachedByEveryStableIntegrator) {
       worst = std::max(worst, static_cast<double>(std::fabs(b.forces.fz[i])));
     }
     EXPECT_LT(worst, 1e-3 * 0.02) << to_string(integrator) << ": residual vs the 0.02 mN load";
-    EXPECT_LT(b.particles.z[centre], -1e-3f) << to_string(integrator) << ": the load pushes the centre down";
+    EXPECT_LT(b.particles.z[centre], -1e-3f)
+        << to_string(integrator) << ": the load pushes the centre down";
   }
 }
 

@@ -18,7 +18,8 @@ Particles row() {
 TEST(Grasp, NearestFreeParticleWithinRadius) {
   const Particles p = row();
   EXPECT_EQ(grasp::nearest_particle(p, {0.9, 0.1, 0}, 0.3), 1u);
-  EXPECT_EQ(grasp::nearest_particle(p, {0.5, 0, 0}, 0.3), kInvalidIndex) << "anchored ones are never taken";
+  EXPECT_EQ(grasp::nearest_particle(p, {0.5, 0, 0}, 0.3), kInvalidIndex)
+      << "anchored ones are never taken";
   EXPECT_EQ(grasp::nearest_particle(p, {0.5, 0, 0}, 0.3, ParticleKind::Anchored), 3u);
   EXPECT_EQ(grasp::nearest_particle(p, {5, 0, 0}, 0.3), kInvalidIndex);
 }
@@ -35,7 +36,8 @@ TEST(Grasp, CloseHoldMoveAndRelease) {
   EXPECT_EQ(p.kind[1], ParticleKind::Scripted);
   EXPECT_FLOAT_EQ(p.x[1], 1.1f) << "the held particle sits at the tip";
 
-  grasp::update_grasp(s, p, {1.1, 0, 0.5}, 0.4, dt);  // grip between open_at and close_at: still held
+  grasp::update_grasp(s, p, {1.1, 0, 0.5}, 0.4,
+                      dt);  // grip between open_at and close_at: still held
   EXPECT_TRUE(s.holding());
   EXPECT_FLOAT_EQ(p.z[1], 0.5f);
   EXPECT_NEAR(p.vz[1], 50.0, 1e-3) << "velocity follows the tool: 0.5 mm in 10 ms";

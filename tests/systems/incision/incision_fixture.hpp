@@ -7,11 +7,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "tests/support/expect_invalid.hpp"
 #include "procedures/eye/eye_geometry.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "systems/incision/keratome.hpp"
 #include "systems/incision/wound.hpp"
+#include "tests/support/expect_invalid.hpp"
 
 namespace phaco::incision::test {
 

@@ -22,7 +22,8 @@ TEST(FlapForceStep, NeedsTheThresholdAndCombinesForceAndCutDirection) {
   s.b_mm = 0.02;
   s.max_step_mm = 1.0;
   const Vec3 tip(2, 0, 0), c_hat(0, 1, 0);
-  EXPECT_EQ(flap_force_step(tip, kUp, c_hat, Vec3(9.9, 0, 0), s), Vec3::Zero()) << "below the threshold";
+  EXPECT_EQ(flap_force_step(tip, kUp, c_hat, Vec3(9.9, 0, 0), s), Vec3::Zero())
+      << "below the threshold";
   // The normal part of the force does not count toward the threshold.
   EXPECT_EQ(flap_force_step(tip, kUp, c_hat, Vec3(6, 0, 50), s), Vec3::Zero());
   const Vec3 step = flap_force_step(tip, kUp, c_hat, Vec3(30, 0, 5), s);
@@ -46,7 +47,8 @@ TEST(Runout, WarnsOnOutwardTurnsAndNearTheSafeEdge) {
   EXPECT_NEAR(out.outward_angle_deg, 45.0, 1e-9);
   EXPECT_TRUE(out.warn);
   EXPECT_FALSE(check_runout(tip, Vec3(-1, 1, 0), s).warn) << "turning inward";
-  EXPECT_TRUE(check_runout(Vec3(3.45, 0, 0), Vec3(0, 1, 0), s).warn) << "tangential but about to leave";
+  EXPECT_TRUE(check_runout(Vec3(3.45, 0, 0), Vec3(0, 1, 0), s).warn)
+      << "tangential but about to leave";
   EXPECT_NEAR(check_runout(Vec3(3.0, 0, 0), Vec3(1, 0, 0), s).distance_to_safe_edge_mm, 0.5, 1e-12);
 }
 
@@ -95,7 +97,8 @@ TEST(TearStep, WarnsOncePerOutwardExcursionAndRecordsTheTearOutOnce) {
   t.b_mm = 0.0;
   t.max_step_mm = 0.3;
   TearState state;
-  for (int k = 0; k < 20 && !state.complete; ++k) tear_step(m, path, state, Vec3(30, 30, 0), t, cs, log);
+  for (int k = 0; k < 20 && !state.complete; ++k)
+    tear_step(m, path, state, Vec3(30, 30, 0), t, cs, log);
   EXPECT_EQ(state.count(TearEvent::RunoutWarning), 1u);
   EXPECT_EQ(state.count(TearEvent::RadialTearout), 1u);
   ASSERT_FALSE(state.events.empty());
@@ -114,7 +117,8 @@ TEST(TearStep, RefusesToTearWithoutACutOrWithABadForce) {
   EXPECT_THROW(tear_step(m, path, state, Vec3(20, 0, 0), {}, {}, log), std::invalid_argument);
   cut::cut_towards(m, path, Vec3(1.2, 1.3, 0), {}, log);
   cut::cut_towards(m, path, Vec3(2.3, 1.6, 0), {}, log);
-  EXPECT_THROW(tear_step(m, path, state, Vec3(std::nan(""), 0, 0), {}, {}, log), std::invalid_argument);
+  EXPECT_THROW(tear_step(m, path, state, Vec3(std::nan(""), 0, 0), {}, {}, log),
+               std::invalid_argument);
 }
 
 // The tear as the force limit (issue 17 item 5). A flap modelled as a linear strip of stiffness k
