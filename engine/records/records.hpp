@@ -34,7 +34,7 @@ class RecordBackend;
 }
 
 // The schema this code writes (migrations.hpp). A database with a newer version is refused
-// rather than misread; an older one is upgraded when opened for writing.
+// rather than misread; an older one is upgraded when opened (history and export too).
 inline constexpr int kRecordsSchemaVersion = 2;
 
 // One finished drill. Times are UTC, ISO 8601 with milliseconds ("2026-11-21T19:18:01.123Z"),
