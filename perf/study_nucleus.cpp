@@ -70,8 +70,8 @@ void run_nucleus(const StudyOptions& options) {
   std::vector<std::string> failures;
   Progress progress((max_level + 1) * 3);
   for (int level = 0; level <= max_level; ++level) {
-    SweepPointConfig c{.drill = "nucleus_removal", .scenario = scenario, .level = level,
-                       .cache_dir = cache};
+    SweepPointConfig c{
+        .drill = "nucleus_removal", .scenario = scenario, .level = level, .cache_dir = cache};
     progress.step("nucleus: level " + std::to_string(level) + " meshes");
     SweepPointConfig warm = c;
     warm.warm_only = true;
@@ -94,9 +94,9 @@ void run_nucleus(const StudyOptions& options) {
   const SweepPointResult* finest = find(max_level, 1);
 
   Table t;
-  t.columns = {"level",        "threads",      "cells",        "fragments_max", "sph_pairs_mean",
+  t.columns = {"level",         "threads",      "cells",        "fragments_max", "sph_pairs_mean",
                "sph_pairs_max", "frame_p50_ms", "frame_p99_ms", "frame_max_ms",  "lens_mean_ms",
-               "speedup",      "error_pct",    "score"};
+               "speedup",       "error_pct",    "score"};
   Chart cost{.title = "Nucleus removal: frame time per level (expert, 70 s)",
              .x = {.label = "lens cells", .scale = Scale::Log10},
              .y = {.label = "frame time (ms)", .scale = Scale::Log10}};
@@ -112,9 +112,10 @@ void run_nucleus(const StudyOptions& options) {
         "volume removed, the cracks and the chopper's largest push against the finest level "
         "measured here (level " +
         std::to_string(max_level) + ").\n\n";
-  md += "| level | threads | cells | fragments (max) | SPH pairs / frame (mean, max) | frame "
-        "p50 / p99 / max (ms) | lens_fragments mean (ms) | 2-thread speed-up | error vs finest "
-        "| score | state hash 1 = 2 |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+  md +=
+      "| level | threads | cells | fragments (max) | SPH pairs / frame (mean, max) | frame "
+      "p50 / p99 / max (ms) | lens_fragments mean (ms) | 2-thread speed-up | error vs finest "
+      "| score | state hash 1 = 2 |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
   for (const Row& row : rows) {
     if (!row.r.ok) continue;
     const SweepPointResult& r = row.r;
@@ -147,8 +148,8 @@ void run_nucleus(const StudyOptions& options) {
           f("%.0f", cells) + " | " + f("%.0f", frags) + " | " + f("%.0f", pm) + ", " +
           f("%.0f", px) + " | " + f("%.2f", r.frame.p50_ms) + " / " + f("%.2f", r.frame.p99_ms) +
           " / " + f("%.1f", r.frame.max_ms) + " | " + f("%.2f", lens_ms) + " | " +
-          (row.threads == 2 ? f("%.2f×", speedup) : std::string("")) + " | " +
-          f("%.1f %%", err) + " | " + f("%.1f", score) + " | " +
+          (row.threads == 2 ? f("%.2f×", speedup) : std::string("")) + " | " + f("%.1f %%", err) +
+          " | " + f("%.1f", score) + " | " +
           (row.threads == 2 ? (same_hash ? "yes" : "**no**") : "") + " |\n";
   }
   if (!p99_1.x.empty()) {
@@ -163,7 +164,8 @@ void run_nucleus(const StudyOptions& options) {
   write_json(t, dir / "nucleus.json");
   const SweepPointResult* l3 = find(3, 2);
   md += "\nTarget (issue 19): the expert at level 3 on 2 threads, frame p99 ≤ 8 ms: ";
-  md += l3 ? f("%.2f", l3->frame.p99_ms) + " ms, " + (l3->frame.p99_ms <= 8.0 ? "**met**" : "**missed**")
+  md += l3 ? f("%.2f", l3->frame.p99_ms) + " ms, " +
+                 (l3->frame.p99_ms <= 8.0 ? "**met**" : "**missed**")
            : std::string("not measured (level 3 not run)");
   md += ".\n\n![nucleus cost](results/nucleus_cost.png)\n\n";
   if (!failures.empty()) {
