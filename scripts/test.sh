@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The README's second command (and what .ci/run calls): installs what is needed, builds, and
-# runs every test; then builds the ASan+UBSan configuration and runs every test again under it
+# The README's second command (and what .ci/run calls): installs what is needed, checks every C++
+# file against .clang-format, builds, starts a throwaway PostgreSQL server and the xAPI validator
+# for the records tests, and runs every test; then builds the ASan+UBSan configuration and runs every test again under it
 # (skip that with PHACO_SKIP_SANITIZERS=1 for a quick local run), and the haptic tests (the 1 kHz
 # loop, the lock-free handoff, the devices, the session) under ThreadSanitizer. TSan runs only those:
 # Debian's libtbb is not instrumented, so TSan would report oneTBB's own hand-offs as races, and
