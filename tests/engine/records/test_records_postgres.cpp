@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <string>
 #include <thread>
@@ -85,6 +86,39 @@ std::string stamp(int i) {
   std::snprintf(buf, sizeof buf, "2026-11-%02dT%02d:%02d:00.000Z", 1 + i / 1440 % 28, i / 60 % 24,
                 i % 60);
   return buf;
+}
+
+// Stations as processes: forks one child per index, each running `station(i)` (true: it did its
+// job) and leaving by _exit (an exception is printed and counts as a failure). Returns the
+// children, for wait_stations.
+std::vector<pid_t> start_stations(int n, const std::function<bool(int)>& station) {
+  std::vector<pid_t> children;
+  for (int i = 0; i < n; ++i) {
+    const pid_t child = fork();
+    if (child == 0) {
+      int code = 4;
+      try {
+        code = station(i) ? 0 : 4;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "station %d: %s\n", i, e.what());
+        code = 5;
+      }
+      _exit(code);
+    }
+    children.push_back(child);
+  }
+  return children;
+}
+
+// How many of them failed (a fork that failed, a non-zero exit or a signal).
+int wait_stations(const std::vector<pid_t>& children) {
+  int failures = 0;
+  for (const pid_t c : children) {
+    int status = 0;
+    failures +=
+        c < 0 || waitpid(c, &status, 0) != c || !WIFEXITED(status) || WEXITSTATUS(status) != 0;
+  }
+  return failures;
 }
 
 class PostgresRecords : public ::testing::Test {
@@ -237,23 +271,9 @@ TEST_F(PostgresRecords, StationsOpeningAFreshDatabaseAtOnceCreateItsSchemaOnce) 
   PQclear(r);
 
   constexpr int kStations = 8;
-  std::vector<pid_t> children;
-  for (int t = 0; t < kStations; ++t) {
-    const pid_t child = fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
-      int code = 0;
-      try {
-        RecordStore centre(uri_);
-        if (centre.schema_version() != phaco::kRecordsSchemaVersion) code = 4;
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "station: %s\n", e.what());
-        code = 5;
-      }
-      _exit(code);
-    }
-    children.push_back(child);
-  }
+  const std::vector<pid_t> children = start_stations(kStations, [&](int) {
+    return RecordStore(uri_).schema_version() == phaco::kRecordsSchemaVersion;
+  });
   // Let the stations connect, look and queue for the lock (a wait for the others to get there,
   // not a measurement), then commit.
   for (int i = 0; i < 200 && admin_count(admin_,
@@ -269,12 +289,7 @@ TEST_F(PostgresRecords, StationsOpeningAFreshDatabaseAtOnceCreateItsSchemaOnce) 
   ASSERT_EQ(PQresultStatus(r), PGRES_COMMAND_OK) << PQerrorMessage(first);
   PQclear(r);
   PQfinish(first);
-  int failures = 0;
-  for (const pid_t c : children) {
-    int status = 0;
-    waitpid(c, &status, 0);
-    failures += !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-  }
+  const int failures = wait_stations(children);
   EXPECT_EQ(failures, 0);
   EXPECT_EQ(admin_count(uri_, "SELECT count(*) FROM phaco_schema"), 1);
   EXPECT_EQ(admin_count(uri_, "SELECT version FROM phaco_schema"), phaco::kRecordsSchemaVersion);
@@ -524,31 +539,14 @@ TEST_F(PostgresRecords, SixteenStationsSyncingAtOnceStoreEveryRecordOnce) {
   std::vector<fs::path> files;
   for (int s = 0; s < kStations; ++s)
     files.push_back(station("s" + std::to_string(s), kEach, "trainee " + std::to_string(s % 5)));
-  std::vector<pid_t> children;
-  for (const fs::path& f : files) {
-    const pid_t child = fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
-      int code = 0;
-      try {
-        RecordStore st(f);
-        RecordStore centre(uri_);
-        phaco::SyncOptions o;
-        o.batch = 20;
-        const auto r = phaco::sync_records(st, centre, o);
-        code = r.uploaded == static_cast<size_t>(kEach) ? 0 : 4;
-      } catch (...) {
-        code = 5;
-      }
-      _exit(code);
-    }
-    children.push_back(child);
-  }
-  for (const pid_t c : children) {
-    int status = 0;
-    ASSERT_EQ(waitpid(c, &status, 0), c);
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "station exit " << status;
-  }
+  const std::vector<pid_t> children = start_stations(kStations, [&](int i) {
+    RecordStore st(files[static_cast<size_t>(i)]);
+    RecordStore centre(uri_);
+    phaco::SyncOptions o;
+    o.batch = 20;
+    return phaco::sync_records(st, centre, o).uploaded == static_cast<size_t>(kEach);
+  });
+  EXPECT_EQ(wait_stations(children), 0);
   EXPECT_EQ(centre_count(), kStations * kEach);
   EXPECT_EQ(centre_distinct(), kStations * kEach);
   EXPECT_EQ(admin_count(uri_, "SELECT count(*) FROM trainees"), 5);
