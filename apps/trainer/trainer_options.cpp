@@ -8,6 +8,7 @@
 #include "engine/core/error.hpp"
 #include "engine/io/json_reader.hpp"
 #include "engine/records/record_location.hpp"
+#include "engine/records/record_run.hpp"
 #include "procedures/eye/eye_params.hpp"
 
 namespace phaco::trainer {
@@ -25,8 +26,7 @@ usage:
   phaco-trainer --help
 
   --drill       corneal_incision | capsulorhexis | phaco_sculpting | nucleus_removal (default
-                capsulorhexis); the
-                tools start where the drill's expert scenario starts them
+                capsulorhexis); the tools start where the drill's expert scenario starts them
   --scenario    any scenario file instead (its tracks give the tools and start poses)
   --difficulty  a level of the drill file (data/drills/<drill>.json: standard, easy, hard, ...)
   --left/--right  the hand's device: desktop (mouse, keyboard, gamepad; default), scripted (the
@@ -116,7 +116,8 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   if (!o.sync_to.empty() && !is_postgres_uri(o.sync_to))
     throw InputError("--sync-to: expected a postgresql:// URI, got '" + shown_location(o.sync_to) +
                      "'");
-  if (!o.sync_to.empty() && is_postgres_uri(o.db.string()))
+  // The station records to its own file first: --db (or $PHACO_DB) must not be a server too.
+  if (!o.sync_to.empty() && is_postgres_uri((o.db.empty() ? default_records_db() : o.db).string()))
     throw InputError("--sync-to: the station records to its own file first; --db is a server");
   if (auto v = a.option("--size")) {
     const auto x = v->find('x');
