@@ -146,4 +146,8 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
+std::string fmt_or_dash(const char* format, double v) {
+  return std::isfinite(v) ? fmt(format, v) : std::string("-");
+}
+
 }  // namespace phaco::perf

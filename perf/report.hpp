@@ -53,5 +53,7 @@ std::string load_note();
 
 // printf-style formatting of one number.
 std::string fmt(const char* format, double v);
+// The same, or "-" for a NaN or infinite value (a figure that was not measured).
+std::string fmt_or_dash(const char* format, double v);
 
 }  // namespace phaco::perf

@@ -25,18 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The outcome the drill scores that a coarser lens can change: the volume emulsified and
-// aspirated, the cracks made, the chopper's largest push.
-const std::vector<std::string> kOutcome = {"volume_removed_fraction", "cracks",
-                                           "chopper_force_mN.max"};
-
-double metric(const SweepPointResult& r, const std::string& k) {
-  return r.metrics.contains(k) && r.metrics[k].is_number() ? r.metrics[k].get<double>()
-                                                           : std::nan("");
-}
-
 std::string f(const char* format, double v) {
-  return std::isfinite(v) ? fmt(format, v) : std::string("-");
+  return fmt_or_dash(format, v);
 }
 
 }  // namespace
@@ -119,7 +109,7 @@ void run_nucleus(const StudyOptions& options) {
   for (const Row& row : rows) {
     if (!row.r.ok) continue;
     const SweepPointResult& r = row.r;
-    const double cells = physics_number(r, "lens_fragments", "cells");
+    const double cells = drill_elements(r);
     const double frags = physics_number(r, "lens_fragments", "max_fragments");
     const double pm = physics_number(r, "lens_fragments", "contact_pairs_mean");
     const double px = physics_number(r, "lens_fragments", "contact_pairs_max");
@@ -127,14 +117,9 @@ void run_nucleus(const StudyOptions& options) {
     const SweepPointResult* one = find(row.level, 1);
     const double speedup =
         row.threads == 2 && one ? one->frame.mean_ms / r.frame.mean_ms : std::nan("");
-    double err = 0;
-    for (const std::string& k : kOutcome) {
-      const double a = metric(r, k), b = finest ? metric(*finest, k) : std::nan("");
-      err = std::max(err, std::isfinite(a) && std::isfinite(b) && b != 0
-                              ? 100.0 * std::fabs(a - b) / std::fabs(b)
-                              : std::nan(""));
-    }
-    const double score = metric(r, "score");
+    // The sweep's own measure of a drill's outcome against a reference (sweep_data.hpp).
+    const double err = finest ? accuracy_error_pct(r, *finest) : std::nan("");
+    const double score = point_metric(r, "score");
     const bool same_hash = row.threads == 2 && one ? one->state_hash == r.state_hash : true;
     if (!same_hash)
       failures.push_back("level " + std::to_string(row.level) +

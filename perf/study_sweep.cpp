@@ -102,7 +102,7 @@ std::string label(const SweepPointConfig& c) {
 }
 
 std::string f(const char* format, double v) {
-  return std::isfinite(v) ? fmt(format, v) : std::string("-");
+  return fmt_or_dash(format, v);
 }
 
 std::string met(bool ok) {

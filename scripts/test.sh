@@ -37,8 +37,7 @@ cp "$root/tests/tools/xapi/package.json" "$root/tests/tools/xapi/package-lock.js
 export PHACO_XAPI_VALIDATOR="$build/xapi-validator/validate.js"
 # A throwaway PostgreSQL server for the records tests (issue 21): its own folder, a Unix socket
 # there, removed when this script ends, pass or fail (scripts/pg_test_cluster.sh).
-pg_dir="$(mktemp -d "${TMPDIR:-/tmp}/phaco-pg.XXXXXX")"
-rmdir "$pg_dir"
+pg_dir="$(mktemp -d "${TMPDIR:-/tmp}/phaco-pg.XXXXXX")"  # empty: the cluster is made in it
 trap '"$root/scripts/pg_test_cluster.sh" remove "$pg_dir"' EXIT
 eval "$("$root/scripts/pg_test_cluster.sh" start "$pg_dir")"
 export PHACO_TEST_PG_URI PHACO_TEST_PG_DIR PHACO_TEST_PG_CTL

@@ -243,20 +243,20 @@ class PostgresRecords final : public RecordBackend {
     return read_row(r, 0);
   }
 
-  // How many of `names` (SQL list) are tables of the current schema. A query over the catalog,
-  // not to_regclass(): that name lookup may answer from a cache not yet told of another
+  // How many of `names` (comma-separated) are tables of the current schema. A query over the
+  // catalog, not to_regclass(): that name lookup may answer from a cache not yet told of another
   // session's commit (seen: after waiting for the schema lock, it missed phaco_schema).
   int64_t tables_named(const char* names) const {
-    return exec(std::string("SELECT count(*) FROM information_schema.tables WHERE table_schema = "
-                            "current_schema() AND table_name IN (") +
-                    names + ")",
-                {}, "cannot read the schema")
+    return exec(
+               "SELECT count(*) FROM information_schema.tables WHERE table_schema = "
+               "current_schema() AND table_name = ANY(string_to_array($1, ','))",
+               {std::string(names)}, "cannot read the schema")
         .integer(0, 0);
   }
 
   // The version, or 0 when the database has no phaco_schema table yet.
   int stored_version() const {
-    if (tables_named("'phaco_schema'") == 0) return 0;
+    if (tables_named("phaco_schema") == 0) return 0;
     const Result v = exec("SELECT version FROM phaco_schema", {}, "cannot read the version");
     return v.rows() == 1 ? static_cast<int>(v.integer(0, 0)) : 0;
   }
@@ -283,7 +283,7 @@ class PostgresRecords final : public RecordBackend {
       int now = stored_version();
       refuse_newer(now);
       if (now == 0) {
-        if (tables_named("'trainees', 'records'") > 0 && tables_named("'phaco_schema'") == 0) {
+        if (tables_named("trainees,records") > 0 && tables_named("phaco_schema") == 0) {
           throw InputError(shown_ +
                            ": this database has tables named trainees or records but no "
                            "OpenPhaco records schema version (phaco_schema); use a database of "

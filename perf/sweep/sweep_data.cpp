@@ -14,17 +14,18 @@ double element(const SweepPointResult& r, const std::string& key) {
   return it == r.elements.end() ? 0.0 : double(it->second);
 }
 
-double metric(const SweepPointResult& r, const std::string& name) {
+}  // namespace
+
+double point_metric(const SweepPointResult& r, const std::string& name) {
   const auto it = r.metrics.find(name);
   return it != r.metrics.end() && it->is_number() ? it->get<double>()
                                                   : std::numeric_limits<double>::quiet_NaN();
 }
 
-}  // namespace
-
 const char* drill_elements_name(const std::string& drill) {
   if (drill == "capsulorhexis") return "capsule vertices";
   if (drill == "phaco_sculpting") return "lens tets";
+  if (drill == "nucleus_removal") return "lens cells";
   return "cornea vertices";
 }
 
@@ -33,15 +34,17 @@ double drill_elements(const SweepPointResult& r) {
   if (d == "capsulorhexis") return element(r, "capsule.particles");
   if (d == "phaco_sculpting") {
     // Tets left at the end plus those the probe removed: the lens as the drill began.
-    const double removed = metric(r, "tets_removed");
+    const double removed = point_metric(r, "tets_removed");
     return element(r, "lens.tets") + (std::isfinite(removed) ? removed : 0.0);
   }
+  if (d == "nucleus_removal") return physics_number(r, "lens_fragments", "cells");
   return element(r, "cornea.particles");
 }
 
 // The outcome a trainee is scored on, one metric per aspect: for the capsulorhexis the opening's
 // size and roundness; for sculpting the volume removed and the trench's width and depth; for the
-// incision its width and tunnel length (docs/metrics.md).
+// incision its width and tunnel length; for nucleus removal the volume removed, the cracks made and
+// the chopper's largest push (docs/metrics.md).
 const std::vector<std::string>& accuracy_metrics(const std::string& drill) {
   static const std::vector<std::string> rhexis = {"rhexis.diameter_mm", "rhexis.circularity"};
   static const std::vector<std::string> sculpt = {"volume_removed_mm3", "trench.width_mm",
@@ -49,7 +52,10 @@ const std::vector<std::string>& accuracy_metrics(const std::string& drill) {
   static const std::vector<std::string> incision = {"incision.width_mm",
                                                     "incision.tunnel_length_mm"};
   if (drill == "capsulorhexis") return rhexis;
+  static const std::vector<std::string> nucleus = {"volume_removed_fraction", "cracks",
+                                                   "chopper_force_mN.max"};
   if (drill == "phaco_sculpting") return sculpt;
+  if (drill == "nucleus_removal") return nucleus;
   return incision;
 }
 
@@ -57,7 +63,7 @@ double accuracy_error_pct(const SweepPointResult& r, const SweepPointResult& ref
                           std::string* detail) {
   double worst = 0;
   for (const std::string& name : accuracy_metrics(r.config.drill)) {
-    const double m = metric(r, name), ref = metric(reference, name);
+    const double m = point_metric(r, name), ref = point_metric(reference, name);
     if (!std::isfinite(m) || !std::isfinite(ref) || ref == 0) {
       if (detail) *detail = name + " missing";
       return std::numeric_limits<double>::quiet_NaN();

@@ -38,6 +38,9 @@ const std::vector<std::string>& accuracy_metrics(const std::string& drill);
 double accuracy_error_pct(const SweepPointResult& r, const SweepPointResult& reference,
                           std::string* detail = nullptr);
 
+// One of a point's metrics (report.metrics[name]); NaN when absent or not a number.
+double point_metric(const SweepPointResult& r, const std::string& name);
+
 // A number from a point's physics summary (report.physics[body][key]); NaN when absent.
 double physics_number(const SweepPointResult& r, const std::string& body, const std::string& key);
 

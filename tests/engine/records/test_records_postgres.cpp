@@ -275,10 +275,10 @@ TEST_F(PostgresRecords, StationsOpeningAFreshDatabaseAtOnceCreateItsSchemaOnce) 
     return RecordStore(uri_).schema_version() == phaco::kRecordsSchemaVersion;
   });
   // Let the stations connect, look and queue for the lock (a wait for the others to get there,
-  // not a measurement), then commit.
-  for (int i = 0; i < 200 && admin_count(admin_,
-                                         "SELECT count(*) FROM pg_locks WHERE locktype = "
-                                         "'advisory' AND NOT granted") < kStations;
+  // not a measurement; 60 s only guards against a hang), then commit.
+  for (int i = 0; i < 2400 && admin_count(admin_,
+                                          "SELECT count(*) FROM pg_locks WHERE locktype = "
+                                          "'advisory' AND NOT granted") < kStations;
        ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(25));
   EXPECT_EQ(admin_count(admin_,
