@@ -208,22 +208,29 @@ std::vector<size_t> pareto_indices(std::span<const double> x, std::span<const do
   return front;
 }
 
-cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
-  RenderReport report;
-  const int w = std::max(chart.width, kLeft + kLegendWidth + 120);
-  const int h = std::max(chart.height, kTop + kBottom + 120);
-  cv::Mat img(h, w, CV_8UC3, kWhite);
-  const int px0 = kLeft, px1 = w - kLegendWidth - 20, py0 = h - kBottom, py1 = kTop;
+namespace {
 
-  // Gather usable values per axis to size the ranges.
-  std::vector<double> xs, ys;
-  const auto usable_x = [&](double v) {
-    return finite(v) && (chart.x.scale == Scale::Linear || v > 0);
-  };
-  const auto usable_y = [&](double v) {
-    return finite(v) && (chart.y.scale == Scale::Linear || v > 0);
-  };
-  for (const Series& s : chart.series) {
+// The plot box in pixels and the axes' maps, shared by the drawing steps below.
+struct PlotArea {
+  cv::Mat& img;
+  const Chart& chart;
+  int w, h, px0, px1, py0, py1;
+  bool usable_x(double v) const { return finite(v) && (chart.x.scale == Scale::Linear || v > 0); }
+  bool usable_y(double v) const { return finite(v) && (chart.y.scale == Scale::Linear || v > 0); }
+};
+
+struct PlotMaps {
+  AxisMap mx, my;
+  int px0, px1, py0, py1;
+  bool in_box(double px, double py) const {
+    return px >= px0 - 1 && px <= px1 + 1 && py >= py1 - 1 && py <= py0 + 1;
+  }
+};
+
+// The values that size the axes: every drawable point and marker; warns of the others.
+void gather_values(const PlotArea& a, std::vector<double>& xs, std::vector<double>& ys,
+                   RenderReport& report) {
+  for (const Series& s : a.chart.series) {
     const size_t n = std::min(s.x.size(), s.y.size());
     if (s.x.size() != s.y.size()) {
       report.warnings.push_back("series '" + s.name +
@@ -231,7 +238,7 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
     }
     size_t skipped = 0;
     for (size_t i = 0; i < n; ++i) {
-      if (usable_x(s.x[i]) && usable_y(s.y[i])) {
+      if (a.usable_x(s.x[i]) && a.usable_y(s.y[i])) {
         xs.push_back(s.x[i]), ys.push_back(s.y[i]);
       } else {
         ++skipped;
@@ -245,165 +252,203 @@ cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
                                 " point(s) skipped (NaN, infinite, or not positive on a log axis)");
     }
   }
-  for (const Marker& m : chart.markers) {
-    if (usable_x(m.x) && usable_y(m.y))
+  for (const Marker& m : a.chart.markers) {
+    if (a.usable_x(m.x) && a.usable_y(m.y))
       xs.push_back(m.x), ys.push_back(m.y);
     else
       report.warnings.push_back("marker '" + m.label + "' skipped (not drawable on these axes)");
   }
+}
 
-  // Title and axis labels.
-  text(img, fit_text(chart.title, 0.7, w - 20), {kLeft, 34}, 0.7, kInk, 2);
-  const std::string xl = fit_text(chart.x.label, 0.55, px1 - px0);
-  text(img, xl, {(px0 + px1 - text_width(xl, 0.55)) / 2, h - 18}, 0.55, kInk);
-  {
-    const std::string yl = fit_text(chart.y.label, 0.55, py0 - py1);
-    cv::Mat label(24, std::max(1, text_width(yl, 0.55) + 4), CV_8UC3, kWhite);
-    text(label, yl, {2, 17}, 0.55, kInk);
-    cv::Mat rotated;
-    cv::rotate(label, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
-    const int top = std::clamp((py0 + py1 - rotated.rows) / 2, 0, h - rotated.rows);
-    rotated.copyTo(img(cv::Rect(8, top, rotated.cols, rotated.rows)));
+// Title, axis labels (the y label turned upright) and the box.
+void draw_labels(const PlotArea& a) {
+  cv::Mat& img = a.img;
+  text(img, fit_text(a.chart.title, 0.7, a.w - 20), {kLeft, 34}, 0.7, kInk, 2);
+  const std::string xl = fit_text(a.chart.x.label, 0.55, a.px1 - a.px0);
+  text(img, xl, {(a.px0 + a.px1 - text_width(xl, 0.55)) / 2, a.h - 18}, 0.55, kInk);
+  const std::string yl = fit_text(a.chart.y.label, 0.55, a.py0 - a.py1);
+  cv::Mat label(24, std::max(1, text_width(yl, 0.55) + 4), CV_8UC3, kWhite);
+  text(label, yl, {2, 17}, 0.55, kInk);
+  cv::Mat rotated;
+  cv::rotate(label, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
+  const int top = std::clamp((a.py0 + a.py1 - rotated.rows) / 2, 0, a.h - rotated.rows);
+  rotated.copyTo(img(cv::Rect(8, top, rotated.cols, rotated.rows)));
+  cv::rectangle(img, {a.px0, a.py1}, {a.px1, a.py0}, kInk, 1);
+}
+
+void draw_grid(const PlotArea& a, const PlotMaps& m) {
+  cv::Mat& img = a.img;
+  for (double t : axis_ticks(m.mx.lo, m.mx.hi, m.mx.scale)) {
+    const int p = static_cast<int>(std::lround(m.mx.to_pixel(t)));
+    cv::line(img, {p, a.py1}, {p, a.py0}, kGrid, 1);
+    cv::line(img, {p, a.py0}, {p, a.py0 + 5}, kInk, 1);
+    const std::string s = tick_label(t);
+    text(img, s, {p - text_width(s, 0.45) / 2, a.py0 + 22}, 0.45, kInk);
   }
-  cv::rectangle(img, {px0, py1}, {px1, py0}, kInk, 1);
+  for (double t : axis_ticks(m.my.lo, m.my.hi, m.my.scale)) {
+    const int p = static_cast<int>(std::lround(m.my.to_pixel(t)));
+    cv::line(img, {a.px0, p}, {a.px1, p}, kGrid, 1);
+    cv::line(img, {a.px0 - 5, p}, {a.px0, p}, kInk, 1);
+    const std::string s = tick_label(t);
+    text(img, s, {a.px0 - 9 - text_width(s, 0.45), p + 5}, 0.45, kInk);
+  }
+  cv::rectangle(img, {a.px0, a.py1}, {a.px1, a.py0}, kInk, 1);
+}
 
+// The Pareto front of all series' points, drawn behind them as a grey staircase.
+void draw_pareto_front(const PlotArea& a, const PlotMaps& m) {
+  std::vector<double> all_x, all_y;
+  for (const Series& s : a.chart.series) {
+    for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+      if (a.usable_x(s.x[i]) && a.usable_y(s.y[i]))
+        all_x.push_back(s.x[i]), all_y.push_back(s.y[i]);
+    }
+  }
+  const std::vector<size_t> front = pareto_indices(all_x, all_y);
+  for (size_t k = 0; k < front.size(); ++k) {
+    const cv::Point2d p(m.mx.to_pixel(all_x[front[k]]), m.my.to_pixel(all_y[front[k]]));
+    cv::circle(a.img, p, 9, cv::Scalar(160, 160, 160), 2, cv::LINE_AA);
+    if (k + 1 < front.size()) {
+      const cv::Point2d q(m.mx.to_pixel(all_x[front[k + 1]]), m.my.to_pixel(all_y[front[k + 1]]));
+      const cv::Point corner(static_cast<int>(q.x), static_cast<int>(p.y));  // truncated, as before
+      cv::line(a.img, p, corner, cv::Scalar(190, 190, 190), 6, cv::LINE_AA);
+      cv::line(a.img, corner, q, cv::Scalar(190, 190, 190), 6, cv::LINE_AA);
+    }
+  }
+}
+
+// The legend down the right of the plot, one entry after another.
+struct Legend {
+  const PlotArea& a;
+  int x, y;
+  void entry(const std::string& label, const cv::Scalar& c, size_t shape, bool line, bool dashed) {
+    if (y > a.h - 20) return;
+    if (line) {
+      if (dashed)
+        dashed_line(a.img, {double(x), double(y)}, {double(x + 28), double(y)}, c, 2);
+      else
+        cv::line(a.img, {x, y}, {x + 28, y}, c, 2, cv::LINE_AA);
+    }
+    if (shape != size_t(-1)) draw_marker(a.img, {x + 14, y}, shape, c);
+    text(a.img, fit_text(label, 0.45, kLegendWidth - 50), {x + 36, y + 5}, 0.45, kInk);
+    y += 22;
+  }
+};
+
+// A series' fitted power law as a dashed line labelled with its slope; returns the label ("" when
+// the fit's ends fall off the axes), warns when there are too few points.
+std::string draw_power_fit(const PlotArea& a, const PlotMaps& m, const Series& s,
+                           const std::vector<double>& fx, const std::vector<double>& fy,
+                           const cv::Scalar& c, RenderReport& report) {
+  const PowerFit fit = fit_power_law(fx, fy);
+  if (!fit.ok) {
+    report.warnings.push_back("series '" + s.name + "': too few points for a power-law fit");
+    return "";
+  }
+  const auto [xmin, xmax] = std::minmax_element(fx.begin(), fx.end());
+  const double ya = fit.coefficient * std::pow(*xmin, fit.slope);
+  const double yb = fit.coefficient * std::pow(*xmax, fit.slope);
+  if (!m.my.usable(ya) || !m.my.usable(yb)) return "";
+  const cv::Point2d pa(m.mx.to_pixel(*xmin), m.my.to_pixel(ya)),
+      pb(m.mx.to_pixel(*xmax), m.my.to_pixel(yb));
+  dashed_line(a.img, pa, pb, cv::Scalar(60, 60, 60), 1);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "slope %.2f", fit.slope);
+  const cv::Point at(
+      static_cast<int>(std::min(pb.x - text_width(buf, 0.45), a.px1 - 4.0 - text_width(buf, 0.45))),
+      static_cast<int>(std::clamp(pb.y - 8, a.py1 + 14.0, a.py0 - 4.0)));
+  text(a.img, buf, at, 0.45, c, 1);
+  return buf;
+}
+
+// Series si: its lines and markers inside the box, its fit, its legend entry.
+void draw_series(const PlotArea& a, const PlotMaps& m, size_t si, Legend& legend,
+                 RenderReport& report) {
+  const Series& s = a.chart.series[si];
+  const cv::Scalar c = kPalette[si % kPaletteSize];
+  std::vector<cv::Point2d> pts;
+  std::vector<double> fx, fy;
+  for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+    if (!(a.usable_x(s.x[i]) && a.usable_y(s.y[i]))) continue;
+    const cv::Point2d p(m.mx.to_pixel(s.x[i]), m.my.to_pixel(s.y[i]));
+    if (!m.in_box(p.x, p.y)) {  // outside a fixed range
+      ++report.points_skipped;
+      continue;
+    }
+    pts.push_back(p);
+    fx.push_back(s.x[i]), fy.push_back(s.y[i]);
+  }
+  if (pts.empty()) return;
+  report.points_drawn += pts.size();
+  const bool lines = s.style != Style::Scatter;
+  const bool marks = s.style != Style::Line;
+  if (lines) {
+    for (size_t k = 0; k + 1 < pts.size(); ++k) {
+      if (s.dashed)
+        dashed_line(a.img, pts[k], pts[k + 1], c, 2);
+      else
+        cv::line(a.img, pts[k], pts[k + 1], c, 2, cv::LINE_AA);
+    }
+  }
+  if (marks) {
+    for (const auto& p : pts) draw_marker(a.img, p, si, c);
+  }
+  std::string label = s.name;
+  if (s.fit_power_law) {
+    const std::string slope = draw_power_fit(a, m, s, fx, fy, c, report);
+    if (!slope.empty()) label += " (" + slope + ")";
+  }
+  legend.entry(label, c, marks ? si : size_t(-1), lines, s.dashed);
+}
+
+void draw_markers(const PlotArea& a, const PlotMaps& m, RenderReport& report) {
+  for (const Marker& mk : a.chart.markers) {
+    if (!(a.usable_x(mk.x) && a.usable_y(mk.y))) continue;
+    const cv::Point2d p(m.mx.to_pixel(mk.x), m.my.to_pixel(mk.y));
+    if (!m.in_box(p.x, p.y)) continue;
+    const cv::Point d[4] = {cv::Point(p) + cv::Point(0, -7), cv::Point(p) + cv::Point(7, 0),
+                            cv::Point(p) + cv::Point(0, 7), cv::Point(p) + cv::Point(-7, 0)};
+    cv::polylines(a.img, std::vector<cv::Point>(d, d + 4), true, kInk, 2, cv::LINE_AA);
+    text(a.img, mk.label, cv::Point(p) + cv::Point(9, -6), 0.42, kInk);
+    ++report.points_drawn;
+  }
+}
+
+}  // namespace
+
+cv::Mat render_chart(const Chart& chart, RenderReport* report_out) {
+  RenderReport report;
+  const int w = std::max(chart.width, kLeft + kLegendWidth + 120);
+  const int h = std::max(chart.height, kTop + kBottom + 120);
+  cv::Mat img(h, w, CV_8UC3, kWhite);
+  const PlotArea a{img, chart, w, h, kLeft, w - kLegendWidth - 20, h - kBottom, kTop};
+
+  std::vector<double> xs, ys;
+  gather_values(a, xs, ys, report);
+  draw_labels(a);
   const auto xr = axis_range(chart.x, xs);
   const auto yr = axis_range(chart.y, ys);
   if (!xr || !yr || xs.empty()) {
-    text(img, "no data", {(px0 + px1) / 2 - 40, (py0 + py1) / 2}, 0.8, kInk, 2);
+    text(img, "no data", {(a.px0 + a.px1) / 2 - 40, (a.py0 + a.py1) / 2}, 0.8, kInk, 2);
     report.warnings.push_back("chart '" + chart.title + "' has no drawable point");
     if (report_out) *report_out = report;
     return img;
   }
-  const AxisMap mx{xr->first, xr->second, chart.x.scale, static_cast<double>(px0),
-                   static_cast<double>(px1)};
-  const AxisMap my{yr->first, yr->second, chart.y.scale, static_cast<double>(py0),
-                   static_cast<double>(py1)};
-  const auto in_box = [&](double px, double py) {
-    return px >= px0 - 1 && px <= px1 + 1 && py >= py1 - 1 && py <= py0 + 1;
-  };
-
-  // Grid and tick labels.
-  for (double t : axis_ticks(mx.lo, mx.hi, mx.scale)) {
-    const int p = static_cast<int>(std::lround(mx.to_pixel(t)));
-    cv::line(img, {p, py1}, {p, py0}, kGrid, 1);
-    cv::line(img, {p, py0}, {p, py0 + 5}, kInk, 1);
-    const std::string s = tick_label(t);
-    text(img, s, {p - text_width(s, 0.45) / 2, py0 + 22}, 0.45, kInk);
-  }
-  for (double t : axis_ticks(my.lo, my.hi, my.scale)) {
-    const int p = static_cast<int>(std::lround(my.to_pixel(t)));
-    cv::line(img, {px0, p}, {px1, p}, kGrid, 1);
-    cv::line(img, {px0 - 5, p}, {px0, p}, kInk, 1);
-    const std::string s = tick_label(t);
-    text(img, s, {px0 - 9 - text_width(s, 0.45), p + 5}, 0.45, kInk);
-  }
-  cv::rectangle(img, {px0, py1}, {px1, py0}, kInk, 1);
-
-  // Pareto front behind the series.
+  const PlotMaps m{{xr->first, xr->second, chart.x.scale, double(a.px0), double(a.px1)},
+                   {yr->first, yr->second, chart.y.scale, double(a.py0), double(a.py1)},
+                   a.px0,
+                   a.px1,
+                   a.py0,
+                   a.py1};
+  draw_grid(a, m);
+  if (chart.pareto_front) draw_pareto_front(a, m);
+  Legend legend{a, a.px1 + 18, kTop + 12};
+  for (size_t si = 0; si < chart.series.size(); ++si) draw_series(a, m, si, legend, report);
+  draw_markers(a, m, report);
   if (chart.pareto_front) {
-    std::vector<double> all_x, all_y;
-    for (const Series& s : chart.series) {
-      for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
-        if (usable_x(s.x[i]) && usable_y(s.y[i])) all_x.push_back(s.x[i]), all_y.push_back(s.y[i]);
-      }
-    }
-    const std::vector<size_t> front = pareto_indices(all_x, all_y);
-    for (size_t k = 0; k < front.size(); ++k) {
-      const cv::Point2d p(mx.to_pixel(all_x[front[k]]), my.to_pixel(all_y[front[k]]));
-      cv::circle(img, p, 9, cv::Scalar(160, 160, 160), 2, cv::LINE_AA);
-      if (k + 1 < front.size()) {
-        const cv::Point2d q(mx.to_pixel(all_x[front[k + 1]]), my.to_pixel(all_y[front[k + 1]]));
-        cv::line(img, p, {q.x, p.y}, cv::Scalar(190, 190, 190), 6, cv::LINE_AA);
-        cv::line(img, {q.x, p.y}, q, cv::Scalar(190, 190, 190), 6, cv::LINE_AA);
-      }
-    }
-  }
-
-  // Series.
-  int legend_y = kTop + 12;
-  const int lx = px1 + 18;
-  auto legend_entry = [&](const std::string& label, const cv::Scalar& c, size_t shape, bool line,
-                          bool dashed) {
-    if (legend_y > h - 20) return;
-    if (line) {
-      if (dashed)
-        dashed_line(img, {double(lx), double(legend_y)}, {double(lx + 28), double(legend_y)}, c, 2);
-      else
-        cv::line(img, {lx, legend_y}, {lx + 28, legend_y}, c, 2, cv::LINE_AA);
-    }
-    if (shape != size_t(-1)) draw_marker(img, {lx + 14, legend_y}, shape, c);
-    text(img, fit_text(label, 0.45, kLegendWidth - 50), {lx + 36, legend_y + 5}, 0.45, kInk);
-    legend_y += 22;
-  };
-  for (size_t si = 0; si < chart.series.size(); ++si) {
-    const Series& s = chart.series[si];
-    const cv::Scalar c = kPalette[si % kPaletteSize];
-    std::vector<cv::Point2d> pts;
-    std::vector<double> fx, fy;
-    for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
-      if (!(usable_x(s.x[i]) && usable_y(s.y[i]))) continue;
-      const cv::Point2d p(mx.to_pixel(s.x[i]), my.to_pixel(s.y[i]));
-      if (!in_box(p.x, p.y)) {  // outside a fixed range
-        ++report.points_skipped;
-        continue;
-      }
-      pts.push_back(p);
-      fx.push_back(s.x[i]), fy.push_back(s.y[i]);
-    }
-    if (pts.empty()) continue;
-    report.points_drawn += pts.size();
-    const bool lines = s.style != Style::Scatter;
-    const bool marks = s.style != Style::Line;
-    if (lines) {
-      for (size_t k = 0; k + 1 < pts.size(); ++k) {
-        if (s.dashed)
-          dashed_line(img, pts[k], pts[k + 1], c, 2);
-        else
-          cv::line(img, pts[k], pts[k + 1], c, 2, cv::LINE_AA);
-      }
-    }
-    if (marks) {
-      for (const auto& p : pts) draw_marker(img, p, si, c);
-    }
-    std::string label = s.name;
-    if (s.fit_power_law) {
-      const PowerFit fit = fit_power_law(fx, fy);
-      if (fit.ok) {
-        const auto [xmin, xmax] = std::minmax_element(fx.begin(), fx.end());
-        const double ya = fit.coefficient * std::pow(*xmin, fit.slope);
-        const double yb = fit.coefficient * std::pow(*xmax, fit.slope);
-        if (my.usable(ya) && my.usable(yb)) {
-          const cv::Point2d a(mx.to_pixel(*xmin), my.to_pixel(ya)),
-              b(mx.to_pixel(*xmax), my.to_pixel(yb));
-          dashed_line(img, a, b, cv::Scalar(60, 60, 60), 1);
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "slope %.2f", fit.slope);
-          const cv::Point at(static_cast<int>(std::min(b.x - text_width(buf, 0.45),
-                                                       px1 - 4.0 - text_width(buf, 0.45))),
-                             static_cast<int>(std::clamp(b.y - 8, py1 + 14.0, py0 - 4.0)));
-          text(img, buf, at, 0.45, c, 1);
-          label += std::string(" (") + buf + ")";
-        }
-      } else {
-        report.warnings.push_back("series '" + s.name + "': too few points for a power-law fit");
-      }
-    }
-    legend_entry(label, c, marks ? si : size_t(-1), lines, s.dashed);
-  }
-  for (const Marker& m : chart.markers) {
-    if (!(usable_x(m.x) && usable_y(m.y))) continue;
-    const cv::Point2d p(mx.to_pixel(m.x), my.to_pixel(m.y));
-    if (!in_box(p.x, p.y)) continue;
-    const cv::Point d[4] = {cv::Point(p) + cv::Point(0, -7), cv::Point(p) + cv::Point(7, 0),
-                            cv::Point(p) + cv::Point(0, 7), cv::Point(p) + cv::Point(-7, 0)};
-    cv::polylines(img, std::vector<cv::Point>(d, d + 4), true, kInk, 2, cv::LINE_AA);
-    text(img, m.label, cv::Point(p) + cv::Point(9, -6), 0.42, kInk);
-    ++report.points_drawn;
-  }
-  if (chart.pareto_front) {
-    cv::line(img, {lx, legend_y}, {lx + 28, legend_y}, cv::Scalar(190, 190, 190), 6, cv::LINE_AA);
-    text(img, "Pareto front", {lx + 36, legend_y + 5}, 0.45, kInk);
+    cv::line(img, {legend.x, legend.y}, {legend.x + 28, legend.y}, cv::Scalar(190, 190, 190), 6,
+             cv::LINE_AA);
+    text(img, "Pareto front", {legend.x + 36, legend.y + 5}, 0.45, kInk);
   }
   if (report_out) *report_out = report;
   return img;
