@@ -205,6 +205,79 @@ bool finish_cut(CutMesh& m, CutPath& path, const CutSettings& settings, double m
   return made;
 }
 
+namespace {
+
+// Where the tool point lies on the mesh, walked from the last hit. The walk can stop on a lip of
+// the cut, the point lying across it: then it walks again from every triangle round the crack tip
+// (which joins both sides) and keeps the nearest.
+CutPoint locate_target(const CutMesh& m, const CutPath& path, const Vec3& tool_point,
+                       const SnapSettings& snap) {
+  CutPoint target = locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
+                                     path.hint_triangle, tool_point, snap);
+  if (path.tip != kInvalidIndex && target.distance_mm > snap.vertex_snap_mm) {
+    std::vector<uint32_t> fan;
+    vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[path.tip], path.tip,
+               fan);
+    for (uint32_t t : fan) {
+      const CutPoint c =
+          locate_cut_point(m.particles, m.triangles, m.topology.adjacency, t, tool_point, snap);
+      if (c.distance_mm < target.distance_mm) target = c;
+    }
+  }
+  return target;
+}
+
+struct SegmentKinds {
+  CutPoint::Kind from, to;
+  bool subsequent;  // the path had a tip before this segment
+};
+struct LogMarks {
+  size_t touched_before, new_before;  // the log's sizes when the segment began
+};
+
+// After a segment's steps: the path's direction and case counts, the new vertices as the next
+// segment's sources, the remesh along the new edges (Fig. 5a), and the physics of the touched
+// region refreshed.
+void finish_segment(CutMesh& m, CutPath& path, const CutSettings& s, SegmentReport& r, EditLog& log,
+                    const std::vector<uint32_t>& visited, const Vec3& start, SegmentKinds kinds,
+                    LogMarks marks) {
+  const size_t touched_before = marks.touched_before, new_before = marks.new_before;
+  if (r.made) {
+    const Vec3 d = pos(m, path.tip) - start;
+    if (d.norm() > 0) path.direction = d.normalized();
+    r.cut_case = classify_cut(kinds.from, kinds.to, kinds.subsequent);
+    ++path.case_counts[static_cast<int>(r.cut_case)];
+    ++path.span_counts[std::min<uint32_t>(r.triangles_spanned, 3)];
+    ++path.segments;
+  }
+  for (size_t i = new_before; i < log.new_particles.size(); ++i)
+    path.sources.push_back(log.new_particles[i]);
+  if (s.remesh && r.made) {
+    // Fig. 5a: merge pairs along the new path edges (both lips), never at the tip.
+    for (size_t i = new_before; i < log.new_particles.size(); ++i) {
+      const uint32_t v = log.new_particles[i];
+      if (v != path.tip && m.particles.slots.alive(v))
+        merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
+    }
+    for (uint32_t v : visited)
+      if (v != path.tip && m.particles.slots.alive(v))
+        merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
+  }
+  {
+    EditLog region;
+    region.touched_triangles.assign(
+        log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
+        log.touched_triangles.end());
+    refresh_region(m, region);
+    log.clamped_pretension += region.clamped_pretension;
+  }
+  if (r.reached_boundary) path.reached_boundary = true;
+  if (!m.triangles.slots.alive(path.hint_triangle) && m.particles.slots.alive(path.tip))
+    path.hint_triangle = m.topology.vertex_triangle[path.tip];
+}
+
+}  // namespace
+
 SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, const CutSettings& s,
                           EditLog& log) {
   SegmentReport r;
@@ -215,20 +288,7 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     return r;
   }
   path.tool_points.push_back(tool_point);
-  CutPoint target = locate_cut_point(m.particles, m.triangles, m.topology.adjacency,
-                                     path.hint_triangle, tool_point, s.snap);
-  if (path.tip != kInvalidIndex && target.distance_mm > s.snap.vertex_snap_mm) {
-    // The walk can stop on a lip of the cut, the point lying across it: walk again from every
-    // triangle round the tip (the crack tip joins both sides), and keep the nearest.
-    std::vector<uint32_t> fan;
-    vertex_fan(m.triangles, m.topology.adjacency, m.topology.vertex_triangle[path.tip], path.tip,
-               fan);
-    for (uint32_t t : fan) {
-      const CutPoint c =
-          locate_cut_point(m.particles, m.triangles, m.topology.adjacency, t, tool_point, s.snap);
-      if (c.distance_mm < target.distance_mm) target = c;
-    }
-  }
+  const CutPoint target = locate_target(m, path, tool_point, s.snap);
   path.hint_triangle = target.triangle;
   if (!path.started) {
     path.started = true;
@@ -327,38 +387,8 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     if (arrives) break;
   }
 
-  if (r.made) {
-    const Vec3 d = pos(m, path.tip) - start;
-    if (d.norm() > 0) path.direction = d.normalized();
-    r.cut_case = classify_cut(from_kind, to_kind, subsequent);
-    ++path.case_counts[static_cast<int>(r.cut_case)];
-    ++path.span_counts[std::min<uint32_t>(r.triangles_spanned, 3)];
-    ++path.segments;
-  }
-  for (size_t i = new_before; i < log.new_particles.size(); ++i)
-    path.sources.push_back(log.new_particles[i]);
-  if (s.remesh && r.made) {
-    // Fig. 5a: merge pairs along the new path edges (both lips), never at the tip.
-    for (size_t i = new_before; i < log.new_particles.size(); ++i) {
-      const uint32_t v = log.new_particles[i];
-      if (v != path.tip && m.particles.slots.alive(v))
-        merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
-    }
-    for (uint32_t v : visited)
-      if (v != path.tip && m.particles.slots.alive(v))
-        merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
-  }
-  {
-    EditLog region;
-    region.touched_triangles.assign(
-        log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
-        log.touched_triangles.end());
-    refresh_region(m, region);
-    log.clamped_pretension += region.clamped_pretension;
-  }
-  if (r.reached_boundary) path.reached_boundary = true;
-  if (!m.triangles.slots.alive(path.hint_triangle) && m.particles.slots.alive(path.tip))
-    path.hint_triangle = m.topology.vertex_triangle[path.tip];
+  finish_segment(m, path, s, r, log, visited, start, {from_kind, to_kind, subsequent},
+                 {touched_before, new_before});
   return r;
 }
 

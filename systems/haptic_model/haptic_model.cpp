@@ -280,24 +280,15 @@ void reset_nodes(HapticSlot& s) {
   std::fill(s.warm_dv.begin(), s.warm_dv.end(), 0.0);
 }
 
-// One step of the local nodes (backward Euler, or symplectic Euler for comparison). Returns the CG
-// iterations; false in `ok` when the result was not finite (the slot is then reset).
-int integrate_nodes(HapticSlot& s, HapticScratch& sc, const Vec3& dev, double kc, double ks,
-                    double r, const std::array<HapticContact, kHapticMaxContacts>& contacts,
-                    uint32_t ncontacts, const HapticSettings& st, bool& ok) {
-  ok = true;
+// The forces on the nodes at the start of the step into sc.rhs (springs, seed 003 §E.1; damping,
+// §E.2–3; the forceps' coupling; the patch reaction) and the diagonal of their stiffness into
+// sc.diag, with each spring's block (sc.sa, sb, sdx..sdz) for the stiffness product.
+void accumulate_forces(const HapticSlot& s, HapticScratch& sc, const Vec3& dev, double kc,
+                       double ks, double r,
+                       const std::array<HapticContact, kHapticMaxContacts>& contacts,
+                       uint32_t ncontacts, uint32_t grasped, double damping) {
   const HapticTool& m = s.model;
   const uint32_t n = m.node_count;
-  const double dt = st.dt_s;
-  const double damping = std::max(0.0, double(m.damping_mn_s_per_mm));
-  const uint32_t grasped = m.grasped_node < n ? m.grasped_node : kHapticMaxNodes;
-  bool any = false;
-  for (uint32_t i = 0; i < n; ++i) {
-    sc.unknown[i] = (m.kind[i] == HapticNodeKind::Free || i == grasped) ? 1 : 0;
-    any = any || sc.unknown[i];
-  }
-  if (!any) return 0;
-
   // Forces at the start of the step (into rhs for now) and the spring blocks.
   double* f = sc.rhs.data();
   std::fill(f, f + 3 * n, 0.0);
@@ -347,89 +338,121 @@ int integrate_nodes(HapticSlot& s, HapticScratch& sc, const Vec3& dev, double kc
       }
     }
   }
+}
 
-  if (st.integrator == NodeIntegrator::SymplecticEuler) {
-    for (uint32_t i = 0; i < n; ++i) {
-      if (!sc.unknown[i] || !(m.mass[i] > 0)) continue;
-      const double im = dt / m.mass[i];
-      s.vx[i] += im * f[3 * i], s.vy[i] += im * f[3 * i + 1], s.vz[i] += im * f[3 * i + 2];
-      s.x[i] += dt * s.vx[i], s.y[i] += dt * s.vy[i], s.z[i] += dt * s.vz[i];
-    }
-  } else {
-    if (ncontacts == 0 && grasped >= n) {  // nothing holds or presses the nodes: at rest, sleep
-      double fmax = 0, vmax = 0;
-      for (uint32_t i = 0; i < n; ++i) {
-        if (!sc.unknown[i]) continue;
-        fmax = std::max({fmax, std::abs(f[3 * i]), std::abs(f[3 * i + 1]), std::abs(f[3 * i + 2])});
-        vmax = std::max({vmax, std::abs(s.vx[i]), std::abs(s.vy[i]), std::abs(s.vz[i])});
-      }
-      if (fmax < st.sleep_force_mn && vmax < 1e-6) return 0;
-    }
-    for (uint32_t i = 0; i < 3 * n; ++i) {
-      sc.u3[i] = sc.unknown[i / 3];
-      sc.m3[i] = sc.u3[i] * (m.mass[i / 3] + dt * damping);
-    }
-    // (M + dt·c·I + dt²·K)·Δv = dt·(f − dt·K·v), v over the unknowns only (fixed nodes do not
-    // move).
-    double* v = sc.p.data();
-    for (uint32_t i = 0; i < n; ++i) {
-      const double u = sc.unknown[i];
-      v[3 * i] = u * s.vx[i], v[3 * i + 1] = u * s.vy[i], v[3 * i + 2] = u * s.vz[i];
-    }
-    apply_stiffness(s, sc, grasped, kc, contacts, ncontacts, ks, v, sc.q.data());
-    double* b = sc.rhs.data();  // overwrites f in place
-    double bnorm2 = 0;
-    const double dt2 = dt * dt;
-    for (uint32_t i = 0; i < 3 * n; ++i) {
-      b[i] = sc.u3[i] * dt * (f[i] - dt * sc.q[i]);
-      sc.diag[i] = std::max(sc.m3[i] + dt2 * sc.diag[i], 1e-300);
-      bnorm2 += b[i] * b[i];
-    }
-    auto apply_a = [&](const double* x, double* y) {
-      apply_stiffness(s, sc, grasped, kc, contacts, ncontacts, ks, x, y);
-      for (uint32_t i = 0; i < 3 * n; ++i) y[i] = sc.m3[i] * x[i] + sc.u3[i] * dt2 * y[i];
-    };
-    double* x = sc.dv.data();
-    for (uint32_t i = 0; i < 3 * n; ++i) x[i] = sc.u3[i] * s.warm_dv[i];
-    apply_a(x, sc.q.data());
-    double rz = 0, r2 = 0;
-    for (uint32_t i = 0; i < 3 * n; ++i) {
-      sc.r[i] = b[i] - sc.q[i];
-      sc.zr[i] = sc.r[i] / sc.diag[i];
-      sc.p[i] = sc.zr[i];
-      rz += sc.r[i] * sc.zr[i], r2 += sc.r[i] * sc.r[i];
-    }
-    const double tol2 = st.solver_tolerance * st.solver_tolerance * bnorm2;
-    int it = 0;
-    while (it < st.solver_iterations && r2 > tol2 && rz > 0) {
-      apply_a(sc.p.data(), sc.q.data());
-      double pq = 0;
-      for (uint32_t i = 0; i < 3 * n; ++i) pq += sc.p[i] * sc.q[i];
-      if (!(pq > 0)) break;
-      const double alpha = rz / pq;
-      double rz1 = 0;
-      r2 = 0;
-      for (uint32_t i = 0; i < 3 * n; ++i) {
-        x[i] += alpha * sc.p[i];
-        sc.r[i] -= alpha * sc.q[i];
-        sc.zr[i] = sc.r[i] / sc.diag[i];
-        rz1 += sc.r[i] * sc.zr[i], r2 += sc.r[i] * sc.r[i];
-      }
-      const double beta = rz1 / rz;
-      rz = rz1;
-      for (uint32_t i = 0; i < 3 * n; ++i) sc.p[i] = sc.zr[i] + beta * sc.p[i];
-      ++it;
-    }
+// Backward Euler on the unknown nodes: (M + dt·c·I + dt²·K)·Δv = dt·(f − dt·K·v) by Jacobi-
+// preconditioned CG from last step's Δv; the forces are in sc.rhs (accumulate_forces). Returns the
+// CG iterations, or 0 when nothing holds or presses the nodes and they are at rest (they sleep).
+int backward_euler_step(HapticSlot& s, HapticScratch& sc, double kc, double ks,
+                        const std::array<HapticContact, kHapticMaxContacts>& contacts,
+                        uint32_t ncontacts, uint32_t grasped, double damping,
+                        const HapticSettings& st, bool& ok) {
+  const HapticTool& m = s.model;
+  const uint32_t n = m.node_count;
+  const double dt = st.dt_s;
+  const double* f = sc.rhs.data();
+  if (ncontacts == 0 && grasped >= n) {  // nothing holds or presses the nodes: at rest, sleep
+    double fmax = 0, vmax = 0;
     for (uint32_t i = 0; i < n; ++i) {
       if (!sc.unknown[i]) continue;
-      s.vx[i] += x[3 * i], s.vy[i] += x[3 * i + 1], s.vz[i] += x[3 * i + 2];
-      s.x[i] += dt * s.vx[i], s.y[i] += dt * s.vy[i], s.z[i] += dt * s.vz[i];
+      fmax = std::max({fmax, std::abs(f[3 * i]), std::abs(f[3 * i + 1]), std::abs(f[3 * i + 2])});
+      vmax = std::max({vmax, std::abs(s.vx[i]), std::abs(s.vy[i]), std::abs(s.vz[i])});
     }
-    std::copy(x, x + 3 * n, s.warm_dv.begin());
-    for (uint32_t i = 0; i < n; ++i) {
-      if (!(std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && std::isfinite(s.z[i]))) ok = false;
+    if (fmax < st.sleep_force_mn && vmax < 1e-6) return 0;
+  }
+  for (uint32_t i = 0; i < 3 * n; ++i) {
+    sc.u3[i] = sc.unknown[i / 3];
+    sc.m3[i] = sc.u3[i] * (m.mass[i / 3] + dt * damping);
+  }
+  // (M + dt·c·I + dt²·K)·Δv = dt·(f − dt·K·v), v over the unknowns only (fixed nodes do not
+  // move).
+  double* v = sc.p.data();
+  for (uint32_t i = 0; i < n; ++i) {
+    const double u = sc.unknown[i];
+    v[3 * i] = u * s.vx[i], v[3 * i + 1] = u * s.vy[i], v[3 * i + 2] = u * s.vz[i];
+  }
+  apply_stiffness(s, sc, grasped, kc, contacts, ncontacts, ks, v, sc.q.data());
+  double* b = sc.rhs.data();  // overwrites f in place
+  double bnorm2 = 0;
+  const double dt2 = dt * dt;
+  for (uint32_t i = 0; i < 3 * n; ++i) {
+    b[i] = sc.u3[i] * dt * (f[i] - dt * sc.q[i]);
+    sc.diag[i] = std::max(sc.m3[i] + dt2 * sc.diag[i], 1e-300);
+    bnorm2 += b[i] * b[i];
+  }
+  auto apply_a = [&](const double* x, double* y) {
+    apply_stiffness(s, sc, grasped, kc, contacts, ncontacts, ks, x, y);
+    for (uint32_t i = 0; i < 3 * n; ++i) y[i] = sc.m3[i] * x[i] + sc.u3[i] * dt2 * y[i];
+  };
+  double* x = sc.dv.data();
+  for (uint32_t i = 0; i < 3 * n; ++i) x[i] = sc.u3[i] * s.warm_dv[i];
+  apply_a(x, sc.q.data());
+  double rz = 0, r2 = 0;
+  for (uint32_t i = 0; i < 3 * n; ++i) {
+    sc.r[i] = b[i] - sc.q[i];
+    sc.zr[i] = sc.r[i] / sc.diag[i];
+    sc.p[i] = sc.zr[i];
+    rz += sc.r[i] * sc.zr[i], r2 += sc.r[i] * sc.r[i];
+  }
+  const double tol2 = st.solver_tolerance * st.solver_tolerance * bnorm2;
+  int it = 0;
+  while (it < st.solver_iterations && r2 > tol2 && rz > 0) {
+    apply_a(sc.p.data(), sc.q.data());
+    double pq = 0;
+    for (uint32_t i = 0; i < 3 * n; ++i) pq += sc.p[i] * sc.q[i];
+    if (!(pq > 0)) break;
+    const double alpha = rz / pq;
+    double rz1 = 0;
+    r2 = 0;
+    for (uint32_t i = 0; i < 3 * n; ++i) {
+      x[i] += alpha * sc.p[i];
+      sc.r[i] -= alpha * sc.q[i];
+      sc.zr[i] = sc.r[i] / sc.diag[i];
+      rz1 += sc.r[i] * sc.zr[i], r2 += sc.r[i] * sc.r[i];
     }
-    return it;
+    const double beta = rz1 / rz;
+    rz = rz1;
+    for (uint32_t i = 0; i < 3 * n; ++i) sc.p[i] = sc.zr[i] + beta * sc.p[i];
+    ++it;
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    if (!sc.unknown[i]) continue;
+    s.vx[i] += x[3 * i], s.vy[i] += x[3 * i + 1], s.vz[i] += x[3 * i + 2];
+    s.x[i] += dt * s.vx[i], s.y[i] += dt * s.vy[i], s.z[i] += dt * s.vz[i];
+  }
+  std::copy(x, x + 3 * n, s.warm_dv.begin());
+  for (uint32_t i = 0; i < n; ++i) {
+    if (!(std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && std::isfinite(s.z[i]))) ok = false;
+  }
+  return it;
+}
+
+// One step of the local nodes (backward Euler, or symplectic Euler for comparison). Returns the CG
+// iterations; false in `ok` when the result was not finite (the slot is then reset).
+int integrate_nodes(HapticSlot& s, HapticScratch& sc, const Vec3& dev, double kc, double ks,
+                    double r, const std::array<HapticContact, kHapticMaxContacts>& contacts,
+                    uint32_t ncontacts, const HapticSettings& st, bool& ok) {
+  ok = true;
+  const HapticTool& m = s.model;
+  const uint32_t n = m.node_count;
+  const double dt = st.dt_s;
+  const double damping = std::max(0.0, double(m.damping_mn_s_per_mm));
+  const uint32_t grasped = m.grasped_node < n ? m.grasped_node : kHapticMaxNodes;
+  bool any = false;
+  for (uint32_t i = 0; i < n; ++i) {
+    sc.unknown[i] = (m.kind[i] == HapticNodeKind::Free || i == grasped) ? 1 : 0;
+    any = any || sc.unknown[i];
+  }
+  if (!any) return 0;
+  accumulate_forces(s, sc, dev, kc, ks, r, contacts, ncontacts, grasped, damping);
+  if (st.integrator != NodeIntegrator::SymplecticEuler)
+    return backward_euler_step(s, sc, kc, ks, contacts, ncontacts, grasped, damping, st, ok);
+  const double* f = sc.rhs.data();
+  for (uint32_t i = 0; i < n; ++i) {
+    if (!sc.unknown[i] || !(m.mass[i] > 0)) continue;
+    const double im = dt / m.mass[i];
+    s.vx[i] += im * f[3 * i], s.vy[i] += im * f[3 * i + 1], s.vz[i] += im * f[3 * i + 2];
+    s.x[i] += dt * s.vx[i], s.y[i] += dt * s.vy[i], s.z[i] += dt * s.vz[i];
   }
   for (uint32_t i = 0; i < n; ++i) {
     if (!(std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && std::isfinite(s.z[i]) &&
