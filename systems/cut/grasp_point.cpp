@@ -23,17 +23,6 @@ void set_velocity(Particles& p, uint32_t v, const Vec3& u) {
   p.vz[v] = static_cast<float>(u.z());
 }
 
-// Springs and masses of the triangles touched since `touched_before`, as the cutter does after a
-// segment.
-void refresh_since(CutMesh& m, EditLog& log, size_t touched_before) {
-  EditLog region;
-  region.touched_triangles.assign(
-      log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
-      log.touched_triangles.end());
-  refresh_region(m, region);
-  log.clamped_pretension += region.clamped_pretension;
-}
-
 GraspPoint at_vertex(const CutMesh& m, uint32_t v, double moved) {
   GraspPoint g;
   if (anchored(m, v)) return g;  // held by the zonules: the forceps cannot take it

@@ -502,6 +502,15 @@ std::string check_topology(const CutMesh& m) {
   return "";
 }
 
+void refresh_since(CutMesh& m, EditLog& log, size_t touched_before) {
+  EditLog region;
+  region.touched_triangles.assign(
+      log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
+      log.touched_triangles.end());
+  refresh_region(m, region);
+  log.clamped_pretension += region.clamped_pretension;
+}
+
 void refresh_region(CutMesh& m, EditLog& log) {
   std::vector<uint32_t> tris = log.touched_triangles, on_edge, fan, corners;
   std::sort(tris.begin(), tris.end());

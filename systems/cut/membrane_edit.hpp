@@ -139,6 +139,10 @@ bool merge_along_cut(CutMesh& m, uint32_t v, double max_turn_deg, double min_ang
 // masses of their corners (anchored particles keep inverse mass 0). Call after a batch of edits.
 void refresh_region(CutMesh& m, EditLog& log);
 
+// refresh_region over the triangles the log touched since it held `touched_before` of them (as
+// the cutter and the forceps do after a segment or a grasp), adding its clamped pretension to log.
+void refresh_since(CutMesh& m, EditLog& log, size_t touched_before);
+
 // The MembraneTopology against the tables, rebuilt from scratch (O(n log n), for tests and debug
 // builds): every live link names a live triangle across the same edge, and is what a fresh
 // adjacency gives except across opened cut edges and slits; every particle's hint holds it; the

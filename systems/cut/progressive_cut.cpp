@@ -263,14 +263,7 @@ void finish_segment(CutMesh& m, CutPath& path, const CutSettings& s, SegmentRepo
       if (v != path.tip && m.particles.slots.alive(v))
         merge_along_cut(m, v, s.remesh_max_turn_deg, s.min_angle_deg, log);
   }
-  {
-    EditLog region;
-    region.touched_triangles.assign(
-        log.touched_triangles.begin() + static_cast<std::ptrdiff_t>(touched_before),
-        log.touched_triangles.end());
-    refresh_region(m, region);
-    log.clamped_pretension += region.clamped_pretension;
-  }
+  refresh_since(m, log, touched_before);
   if (r.reached_boundary) path.reached_boundary = true;
   if (!m.triangles.slots.alive(path.hint_triangle) && m.particles.slots.alive(path.tip))
     path.hint_triangle = m.topology.vertex_triangle[path.tip];
