@@ -99,7 +99,9 @@ TEST(DurationHistogram, OccupiedBinsHoldEverySampleInOrder) {
   uint64_t total = 0;
   for (size_t i = 0; i < bins.size(); ++i) {
     total += bins[i].count;
-    if (i > 0) EXPECT_GE(bins[i].low_us, bins[i - 1].low_us + bins[i - 1].width_us);
+    if (i > 0) {
+      EXPECT_GE(bins[i].low_us, bins[i - 1].low_us + bins[i - 1].width_us);
+    }
   }
   EXPECT_EQ(total, 6u);
   EXPECT_EQ(bins[0].low_us, 999);

@@ -55,8 +55,9 @@ TEST(CapsuleCutting, TheDemoCutsAndTearsTheCapsuleAndKeepsItSound) {
   bool warned = false;
   for (const auto& e : cc->tear_state.events) {
     if (e.kind == tear::TearEvent::RunoutWarning) warned = true;
-    if (e.kind == tear::TearEvent::RadialTearout)
+    if (e.kind == tear::TearEvent::RadialTearout) {
       EXPECT_TRUE(warned) << "tear-out without a warning first";
+    }
   }
   // The demo's forceps close the circle: the disc comes free, round and about the target size.
   const nlohmann::json j = capsule_cutting_summary(*scene);

@@ -204,8 +204,9 @@ TEST(HapticPublish, TheHeldFlapOfAnOpenTearIsFeltUpToTheTearResistance) {
       felt[limited] = f.force_mn.norm();
     }
     EXPECT_LE(felt[1], cc.tear.threshold_mn + 1e-3) << pull_mm;
-    if (pull_mm >= 2.0)
+    if (pull_mm >= 2.0) {
       EXPECT_GT(felt[0], 2 * cc.tear.threshold_mn) << "without the limit: felt in full";
+    }
   }
 }
 
@@ -319,10 +320,11 @@ TEST(HapticPublish, TheSculptedLensComesAsSpheresOfItsMaterialNearTheTip) {
       saw_probe = true;
       EXPECT_GT(t.sphere_count, 10u) << "the probe is in the lens";
       EXPECT_NEAR(t.tip_radius_mm, 0.45f, 1e-6);
-      if (pose.pedal >= 3.0)
+      if (pose.pedal >= 3.0) {
         EXPECT_NEAR(t.cut_force_mn, settings.lens.cut_force_mn, 1e-4) << "standard eye, power 1";
-      else
+      } else {
         EXPECT_EQ(t.cut_force_mn, 0.0f);
+      }
     } else {
       EXPECT_EQ(t.cut_force_mn, 0.0f) << "only the probe's ultrasound cuts";
     }
@@ -384,7 +386,9 @@ TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsR
   EXPECT_EQ(h.held.fragment, 0u);
   EXPECT_EQ(h.held.mass_kg, 4e-5f);
   EXPECT_EQ(h.held.hold_limit_mn, 11.0f);
-  if (lf.lens.fragments.count == 1) EXPECT_EQ(h.sphere_count, 0u) << "the whole lens is held";
+  if (lf.lens.fragments.count == 1) {
+    EXPECT_EQ(h.sphere_count, 0u) << "the whole lens is held";
+  }
   for (uint32_t j = 0; j < h.sphere_count; ++j) {
     const Vec3 centre(h.sphere_x[j], h.sphere_y[j], h.sphere_z[j]);
     for (uint32_t c = 0; c < lf.lens.cells.size(); ++c) {

@@ -401,7 +401,9 @@ TEST(HapticModel, GraspForceIsBoundedByTheFlapsTearResistance) {
     }
     EXPECT_LE(bounded, limit + 1e-6) << pull;
     EXPECT_NEAR(bounded, std::min(free_pull, limit), 1e-3 * limit) << pull;
-    if (pull >= 2.0) EXPECT_GT(free_pull, 2 * limit) << "the pull is well above the plateau";
+    if (pull >= 2.0) {
+      EXPECT_GT(free_pull, 2 * limit) << "the pull is well above the plateau";
+    }
   }
 }
 

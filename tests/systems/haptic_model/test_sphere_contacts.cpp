@@ -220,7 +220,9 @@ TEST(SphereContacts, ForceIsContinuousAcrossATrenchEdgeAndItsWall) {
     if (k > 0) jump = std::max(jump, (f.force_mn - last).norm());
     last = f.force_mn;
     fmax = std::max(fmax, f.force_mn.norm());
-    if (std::abs(t - 0.75) < 0.05) EXPECT_EQ(f.force_mn.norm(), 0.0) << "over the trench";
+    if (std::abs(t - 0.75) < 0.05) {
+      EXPECT_EQ(f.force_mn.norm(), 0.0) << "over the trench";
+    }
     if (std::abs(t - 0.95) < 0.01) floor_push = f.force_mn.z();
     if (std::abs(t - 1.3) < 0.01) wall_push = f.force_mn.x();
   }

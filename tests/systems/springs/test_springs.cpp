@@ -46,8 +46,9 @@ TEST(BuildSprings, OneSpringPerEdgeWithAreaWeights) {
   ASSERT_EQ(sp.slots.size(), 5u);
   for (uint32_t e = 0; e < 5; ++e) {
     EXPECT_LT(sp.i[e], sp.j[e]);
-    if (e > 0)
+    if (e > 0) {
       EXPECT_TRUE(sp.i[e - 1] < sp.i[e] || (sp.i[e - 1] == sp.i[e] && sp.j[e - 1] < sp.j[e]));
+    }
   }
   // The diagonal (0,2) has both triangles: k = 2·(0.5 + 0.5)/2 = 1; a side has one: k = 2·0.5/1
   // = 1.
