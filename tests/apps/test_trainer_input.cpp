@@ -1,0 +1,148 @@
+// phaco-trainer in a trainee's hands (issue 24 item 5): under Xvfb, xdotool drives the real window
+// with a synthetic pointer, wheel and keys, as a person would, and the trainer's --ui-state file
+// (what the trainee sees: the tools' tips and height readouts, the active hand, the Result table)
+// is read after each step. One run of the capsulorhexis drill with both hands on the desktop:
+//   the controls overlay shows on the drill's first start and F1 hides it;
+//   the pointer jumping onto a panel, off the window and back moves neither tool (clutch);
+//   three wheel clicks lower the active tool's height readout by 0.1 mm each;
+//   Tab switches the active hand;
+//   at the drill's end the Result table shows names with units and targets as ranges (no raw
+//   JSON), every name whole at 1280×720; the recorded track's path lengths show no jump.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/support/environment.hpp"
+#include "tests/support/shell.hpp"
+
+namespace phaco {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using test::shell;
+
+// The steps, as a trainee would take them; each `snap NAME` copies the newest UI state.
+constexpr const char* kScript = R"(set -u
+T="$1"; D="$2"; shift 2
+"$T" --drill capsulorhexis --duration 8 --size 1280x720 --ui-state "$D/state.json" --timeout 300 \
+  "$@" > "$D/trainer.log" 2>&1 &
+P=$!
+for i in $(seq 1200); do
+  grep -qs '"state": "running"' "$D/state.json" && break
+  kill -0 $P 2>/dev/null || { echo "the trainer exited early"; cat "$D/trainer.log"; exit 1; }
+  sleep 0.1
+done
+snap() { sleep 0.5; cp "$D/state.json" "$D/$1.json"; }
+xdotool mousemove 640 400; snap intro
+xdotool key F1; snap s0
+xdotool mousemove 100 100; sleep 0.3     # onto the Drill panel
+xdotool mousemove 700 420; sleep 0.3     # the view
+xdotool mousemove 640 790; sleep 0.3     # below the window
+xdotool mousemove 660 380; sleep 0.3     # the view
+xdotool mousemove 1000 600; sleep 0.3    # onto the History panel
+xdotool mousemove 640 400; snap s1       # the view
+xdotool click --repeat 3 --delay 200 4; snap s2   # the wheel forward: deeper
+xdotool key Tab; snap s3
+for i in $(seq 1200); do grep -qs '"result"' "$D/state.json" && break; sleep 0.1; done
+snap s4
+xdotool key Escape
+wait $P
+echo "trainer exit $?"
+)";
+
+json read_json(const fs::path& f) {
+  std::ifstream in(f);
+  EXPECT_TRUE(in.good()) << f;
+  return in.good() ? json::parse(in) : json::object();
+}
+
+const json& tool_of(const json& state, const std::string& hand) {
+  for (const json& t : state["tools"])
+    if (t["hand"] == hand) return t;
+  ADD_FAILURE() << "no " << hand << " tool in " << state.dump();
+  static const json none = json::object();
+  return none;
+}
+
+double distance(const json& a, const json& b) {
+  double s = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double d = a["tip_mm"][i].get<double>() - b["tip_mm"][i].get<double>();
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
+TEST(TrainerInput, ClutchDepthReadoutTabAndResultAsATraineeUsesThem) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "a real-time drill under ASan and llvmpipe; the Release pass runs it";
+#endif
+  PHACO_REQUIRE_ENVIRONMENT(
+      shell("command -v xvfb-run && command -v xdotool").code == 0,
+      "xvfb-run or xdotool not found (scripts/install-deps.sh installs them)");
+  const fs::path dir =
+      fs::temp_directory_path() / ("phaco-trainer-input-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "steps.sh") << kScript;
+  const char* cache = std::getenv("PHACO_CACHE_DIR");
+  const std::string cmd = "xvfb-run -a -s '-screen 0 1280x800x24' bash " +
+                          (dir / "steps.sh").string() + " " + PHACO_TRAINER_BIN + " " +
+                          dir.string() +
+                          (cache ? std::string(" --cache-dir ") + cache : std::string());
+  const test::ShellResult r = shell(cmd);
+  ASSERT_EQ(r.code, 0) << cmd << "\n" << r.output;
+  ASSERT_NE(r.output.find("trainer exit 0"), std::string::npos) << r.output;
+
+  const json intro = read_json(dir / "intro.json"), s0 = read_json(dir / "s0.json"),
+             s1 = read_json(dir / "s1.json"), s2 = read_json(dir / "s2.json"),
+             s3 = read_json(dir / "s3.json"), s4 = read_json(dir / "s4.json");
+  EXPECT_TRUE(intro["controls_shown"].get<bool>()) << "the drill's first start names its controls";
+  EXPECT_FALSE(s0["controls_shown"].get<bool>()) << "F1 hides them";
+
+  // The pointer's jumps onto panels, off the window and back moved neither tool.
+  for (const char* hand : {"left", "right"})
+    EXPECT_LE(distance(tool_of(s0, hand), tool_of(s1, hand)), 0.05) << hand;
+
+  // Three clicks of the wheel: the active tool 0.3 mm lower, its readout too; the other still.
+  const std::string active = s1["active_hand"];
+  const std::string other = active == "left" ? "right" : "left";
+  const json& before = tool_of(s1, active);
+  const json& after = tool_of(s2, active);
+  ASSERT_TRUE(before["height_mm"].is_number() && after["height_mm"].is_number()) << s2.dump();
+  EXPECT_NEAR(after["height_mm"].get<double>() - before["height_mm"].get<double>(), -0.3, 0.02);
+  EXPECT_NE(after["readout"], before["readout"]);
+  EXPECT_LE(distance(tool_of(s1, other), tool_of(s2, other)), 0.05);
+
+  EXPECT_EQ(s3["active_hand"], other) << "Tab switches the active hand";
+
+  // The Result table: formatted, whole, on screen.
+  ASSERT_TRUE(s4.contains("result")) << s4.dump();
+  const json& result = s4["result"];
+  EXPECT_TRUE(result["on_screen"].get<bool>());
+  ASSERT_FALSE(result["rows"].empty());
+  bool a_range = false;
+  for (const json& row : result["rows"]) {
+    const std::string target = row["target"];
+    EXPECT_EQ(target.find_first_of("{}\":"), std::string::npos) << "raw JSON: " << target;
+    EXPECT_TRUE(row["name_fits"].get<bool>()) << row["metric"];
+    EXPECT_EQ(std::string(row["metric"]).find('_'), std::string::npos) << row["metric"];
+    a_range = a_range || target.find(" – ") != std::string::npos;
+  }
+  EXPECT_TRUE(a_range) << "the rhexis diameter's target reads as a range";
+  // The recorded track over every frame: no jump; the active hand moved by the wheel only.
+  const json& m = result["metrics"];
+  EXPECT_LE(m[other + ".path_length_mm"].get<double>(), 0.05);
+  EXPECT_LE(m[active + ".path_length_mm"].get<double>(), 0.3 + 0.05);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace phaco
