@@ -3,35 +3,18 @@
 #include <cmath>
 #include <limits>
 
-#include "procedures/eye/eye_params.hpp"
-
 namespace phaco {
-
-TipHeightGeometry tip_height_geometry(const eye::EyeParams& p, bool has_capsule) {
-  TipHeightGeometry g;
-  g.cornea_posterior_radius_mm = p.get("cornea.posterior_radius_mm");
-  g.cornea_posterior_apex_z_mm = p.get("cornea.posterior_apex_z_mm");
-  g.cornea_anterior_radius_mm = p.get("cornea.anterior_radius_mm");
-  g.cornea_anterior_apex_z_mm = g.cornea_posterior_apex_z_mm + p.get("cornea.central_thickness_mm");
-  g.limbus_radius_mm = 0.5 * p.get("cornea.limbus_diameter_mm");
-  g.lens_equator_radius_mm = 0.5 * p.get("lens.equatorial_diameter_mm");
-  g.lens_anterior_mm = p.get("lens.anterior_half_thickness_mm");
-  g.lens_posterior_mm = p.get("lens.posterior_half_thickness_mm");
-  g.capsule = has_capsule;
-  return g;
-}
 
 namespace {
 
-// z of a sphere's upper cap (apex at apex_z) at radial distance rho; NaN beyond the sphere.
-double cap_z(double radius, double apex_z, double rho) {
-  const double s = radius * radius - rho * rho;
-  return s < 0 ? std::numeric_limits<double>::quiet_NaN() : apex_z - radius + std::sqrt(s);
+// z of a sphere (centre on the axis at centre_z) on its upper side at radial distance rho.
+double cap_z(double radius, double centre_z, double rho) {
+  return centre_z + std::sqrt(std::max(0.0, radius * radius - rho * rho));
 }
 
 }  // namespace
 
-TipHeight tip_height(const TipHeightGeometry& g, const Vec3& p) {
+TipHeight tip_height(const eye::EyeGeometry& g, bool capsule, const Vec3& p) {
   TipHeight out{std::numeric_limits<double>::quiet_NaN(), render::Tissue::None};
   if (!p.allFinite()) return out;
   const double rho = std::hypot(p.x(), p.y());
@@ -41,22 +24,21 @@ TipHeight tip_height(const TipHeightGeometry& g, const Vec3& p) {
   };
   Layer layers[2];
   int n = 0;
-  if (rho < g.limbus_radius_mm) {
-    const double top = cap_z(g.cornea_anterior_radius_mm, g.cornea_anterior_apex_z_mm, rho);
-    const double bottom = cap_z(g.cornea_posterior_radius_mm, g.cornea_posterior_apex_z_mm, rho);
-    if (std::isfinite(top) && std::isfinite(bottom))
-      layers[n++] = {bottom, top, render::Tissue::Cornea};
+  if (rho < g.limbus_radius) {
+    layers[n++] = {cap_z(g.cornea_posterior_radius, g.cornea_posterior_centre_z, rho),
+                   cap_z(g.cornea_anterior_radius, g.cornea_anterior_centre_z, rho),
+                   render::Tissue::Cornea};
   }
-  if (rho < g.lens_equator_radius_mm) {
-    const double s =
-        std::sqrt(1.0 - (rho / g.lens_equator_radius_mm) * (rho / g.lens_equator_radius_mm));
-    layers[n++] = {-g.lens_posterior_mm * s, g.lens_anterior_mm * s,
-                   g.capsule ? render::Tissue::Capsule : render::Tissue::Lens};
+  if (rho < g.lens_a) {
+    const double s = std::sqrt(std::max(0.0, 1.0 - (rho / g.lens_a) * (rho / g.lens_a)));
+    const bool covered = capsule && rho < g.capsule_radius;
+    layers[n++] = {-g.lens_c_posterior * s, g.lens_anterior_z(rho),
+                   covered ? render::Tissue::Capsule : render::Tissue::Lens};
   }
   for (int i = 0; i < n; ++i) {
     const Layer& l = layers[i];
     if (p.z() >= l.bottom && p.z() <= l.top) return {p.z() - l.top, l.tissue};  // in it
-    // The highest top below the tip (the cornea lies above the lens: checked first).
+    // The nearest top below the tip.
     if (p.z() > l.top && !(out.height_mm <= p.z() - l.top)) out = {p.z() - l.top, l.tissue};
   }
   return out;

@@ -59,7 +59,7 @@ TEST(TipHeight, MatchesTheSceneMeshesWithinTwoHundredthsOfAMillimetre) {
   const render::BodyView* cornea = find_view(snap, "cornea");
   ASSERT_NE(capsule, nullptr);
   ASSERT_NE(cornea, nullptr);
-  const TipHeightGeometry g = tip_height_geometry(scene->params, true);
+  const eye::EyeGeometry g = eye::eye_geometry(scene->params);
 
   int checked = 0;
   // Tips in the anterior chamber over the capsule (where a trainee works), across the pupil.
@@ -69,12 +69,12 @@ TEST(TipHeight, MatchesTheSceneMeshesWithinTwoHundredthsOfAMillimetre) {
         const auto surface = top_below(*capsule, x, y, 10.0);
         ASSERT_TRUE(surface.has_value()) << x << ", " << y;
         const Vec3 tip(x, y, *surface + above);
-        const TipHeight h = tip_height(g, tip);
+        const TipHeight h = tip_height(g, true, tip);
         EXPECT_EQ(h.under, render::Tissue::Capsule);
         EXPECT_NEAR(h.height_mm, above, 0.02) << "tip " << tip.transpose();
         ++checked;
         // 0.3 mm under the capsule: in the lens, that deep.
-        const TipHeight in = tip_height(g, Vec3(x, y, *surface - 0.3));
+        const TipHeight in = tip_height(g, true, Vec3(x, y, *surface - 0.3));
         EXPECT_NEAR(in.height_mm, -0.3, 0.02) << "tip " << tip.transpose();
       }
   // Tips over the cornea, outside the eye: its outer surface is the topmost crossing.
@@ -83,7 +83,7 @@ TEST(TipHeight, MatchesTheSceneMeshesWithinTwoHundredthsOfAMillimetre) {
       const auto zs = crossings(*cornea, x, 0.5);
       ASSERT_FALSE(zs.empty());
       const double top = *std::max_element(zs.begin(), zs.end());
-      const TipHeight h = tip_height(g, Vec3(x, 0.5, top + above));
+      const TipHeight h = tip_height(g, true, Vec3(x, 0.5, top + above));
       EXPECT_EQ(h.under, render::Tissue::Cornea);
       EXPECT_NEAR(h.height_mm, above, 0.02) << x;
       ++checked;
@@ -93,7 +93,7 @@ TEST(TipHeight, MatchesTheSceneMeshesWithinTwoHundredthsOfAMillimetre) {
   // The snapshot carries each tool's height, as tip_height gives it.
   ASSERT_FALSE(snap.tools.empty());
   for (const render::ToolView& t : snap.tools) {
-    const TipHeight h = tip_height(g, t.tip_mm);
+    const TipHeight h = tip_height(g, true, t.tip_mm);
     EXPECT_EQ(t.under, h.under);
     if (std::isfinite(h.height_mm)) {
       EXPECT_DOUBLE_EQ(t.height_mm, h.height_mm);
@@ -102,18 +102,21 @@ TEST(TipHeight, MatchesTheSceneMeshesWithinTwoHundredthsOfAMillimetre) {
 }
 
 TEST(TipHeight, BandsAndNoTissue) {
-  const TipHeightGeometry g;
+  const eye::EyeGeometry g = eye::eye_geometry(eye::default_eye_params());
   EXPECT_EQ(height_band(0.5), HeightBand::Above);
   EXPECT_EQ(height_band(0.05), HeightBand::Touching);
   EXPECT_EQ(height_band(-0.01), HeightBand::In);
-  // Beyond the limbus and the lens's equator: nothing under the tip.
-  const TipHeight none = tip_height(g, Vec3(8.0, 0.0, 2.0));
+  // Beyond the capsule's edge the lens is bare; beyond the limbus and the lens's equator nothing
+  // is under the tip.
+  EXPECT_EQ(tip_height(g, true, Vec3(4.6, 0.0, 2.0)).under, render::Tissue::Lens);
+  EXPECT_EQ(tip_height(g, false, Vec3(0.0, 0.0, 3.0)).under, render::Tissue::Lens);
+  const TipHeight none = tip_height(g, true, Vec3(8.0, 0.0, 2.0));
   EXPECT_FALSE(std::isfinite(none.height_mm));
   EXPECT_EQ(height_band(none.height_mm), HeightBand::None);
-  EXPECT_EQ(tip_height(g, Vec3(NAN, 0, 0)).under, render::Tissue::None);
+  EXPECT_EQ(tip_height(g, true, Vec3(NAN, 0, 0)).under, render::Tissue::None);
   // Each wheel click (0.1 mm down) lowers the height by 0.1 mm over the same spot.
-  const double h0 = tip_height(g, Vec3(0.5, 0.5, 2.5)).height_mm;
-  EXPECT_NEAR(tip_height(g, Vec3(0.5, 0.5, 2.2)).height_mm, h0 - 0.3, 1e-12);
+  const double h0 = tip_height(g, true, Vec3(0.5, 0.5, 2.5)).height_mm;
+  EXPECT_NEAR(tip_height(g, true, Vec3(0.5, 0.5, 2.2)).height_mm, h0 - 0.3, 1e-12);
 }
 
 }  // namespace
