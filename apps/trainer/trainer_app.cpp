@@ -90,7 +90,7 @@ void load_font() {
   static const ImWchar kRanges[] = {0x0020, 0x00FF, 0x2013, 0x2014, 0x2264, 0x2265, 0};
   const char* const path = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
   if (std::filesystem::exists(path))
-    ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 15.0f, nullptr, kRanges);
+    ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 14.0f, nullptr, kRanges);
 }
 
 void write_ui_state(const std::filesystem::path& file, const nlohmann::json& j) {
@@ -180,6 +180,9 @@ int run_trainer(const TrainerOptions& o) {
   InputGlue glue;
   glfwSetWindowUserPointer(window, &glue);
   glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) { glue_of(w)->wheel += dy; });
+  // A key tapped between two frames (a slow software-rendered frame, or a synthetic key) still
+  // reads as pressed once: glfwGetKey keeps the press until it is read.
+  glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();

@@ -86,8 +86,12 @@ void draw_height_labels(const render::RenderSnapshot& snap, const render::Micros
     } else {
       std::snprintf(buf, sizeof buf, "--");
     }
-    const ImVec2 at(static_cast<float>(px[0]) + 14.0f, static_cast<float>(px[1]) - 22.0f);
+    // The left hand's label to the left of its tip, the right hand's to the right: two tips close
+    // together keep their labels apart.
     const ImVec2 size = ImGui::CalcTextSize(buf);
+    const float x = static_cast<float>(px[0]);
+    const ImVec2 at(t.hand == Hand::Left ? x - 14.0f - size.x : x + 14.0f,
+                    static_cast<float>(px[1]) - 22.0f);
     // A dark plate keeps the label legible over the bright red reflex and the white sclera.
     dl->AddRectFilled(ImVec2(at.x - 3, at.y - 1), ImVec2(at.x + size.x + 3, at.y + size.y + 1),
                       IM_COL32(0, 0, 0, 170), 3.0f);

@@ -25,6 +25,8 @@ namespace {
 constexpr std::array<const char*, 4> kDrills = {"corneal_incision", "capsulorhexis",
                                                 "phaco_sculpting", "nucleus_removal"};
 constexpr std::array<const char*, 3> kDevices = {"desktop", "scripted", "track"};
+constexpr std::array<const char*, 4> kStates = {"idle", "running", "paused",
+                                                "ended"};  // TrainerState
 
 // Events a trainee must notice at once (seed 004: warn before the tear runs out).
 bool is_warning(const std::string& kind) {
@@ -103,7 +105,7 @@ void TrainerUi::finish(TrainerSession& session) {
 
 void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("Drill");
   ImGui::InputText("trainee", trainee_, sizeof trainee_);
   if (ImGui::Combo("drill", &drill_index_, kDrills.data(), static_cast<int>(kDrills.size()))) {
@@ -155,7 +157,9 @@ void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
     }
   }
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
-  ImGui::TextDisabled("Tab: other hand  Space: pause  R: restart  G: guidance  F1: controls");
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+  ImGui::TextWrapped("Tab: other hand  Space: pause  R: restart  G: guidance  F1: controls");
+  ImGui::PopStyleColor();
   ImGui::End();
 }
 
@@ -176,9 +180,8 @@ void TrainerUi::live_panel(TrainerSession& session, double frame_ms,
     if (events_.size() > 12) events_.pop_back();
   }
   ImGui::SetNextWindowPos(ImVec2(10, 260), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(360, 300), ImGuiCond_FirstUseEver);
   ImGui::Begin("Live");
-  static constexpr std::array<const char*, 4> kStates = {"idle", "running", "paused", "ended"};
   ImGui::Text("%s  %.1f / %.1f s", kStates[static_cast<size_t>(s.state)], s.sim_time_s,
               s.duration_s);
   ImGui::Text("simulation %.0f Hz   render %.0f fps", s.sim_rate_hz,
@@ -329,7 +332,6 @@ void TrainerUi::view_panel(render::Renderer& renderer, render::Microscope& micro
 
 nlohmann::json TrainerUi::state_json(TrainerSession& session,
                                      const render::RenderSnapshot* snap) const {
-  static constexpr std::array<const char*, 4> kStates = {"idle", "running", "paused", "ended"};
   const TrainerStatus st = session.status();
   nlohmann::json j;
   j["state"] = kStates[static_cast<size_t>(st.state)];
