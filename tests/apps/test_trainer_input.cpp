@@ -4,8 +4,8 @@
 // is read after each step. One run of the capsulorhexis drill with both hands on the desktop:
 //   the controls overlay shows on the drill's first start and F1 hides it;
 //   the pointer jumping onto a panel, off the window and back moves neither tool (clutch);
-//   three wheel clicks lower the active tool's height readout by 0.1 mm each;
 //   Tab switches the active hand;
+//   three wheel clicks lower the active tool's height readout by 0.1 mm each;
 //   at the drill's end the Result table shows names with units and targets as ranges (no raw
 //   JSON), every name whole at 1280×720; the recorded track's path lengths show no jump.
 #include <gtest/gtest.h>
@@ -48,8 +48,8 @@ xdotool mousemove 640 790; sleep 0.3     # below the window
 xdotool mousemove 660 380; sleep 0.3     # the view
 xdotool mousemove 1000 600; sleep 0.3    # onto the History panel
 xdotool mousemove 640 400; snap s1       # the view
-xdotool click --repeat 3 --delay 200 4; snap s2   # the wheel forward: deeper
-xdotool key Tab; snap s3
+xdotool key Tab; snap s2
+xdotool click --repeat 3 --delay 200 4; snap s3   # the wheel forward: deeper
 for i in $(seq 1200); do grep -qs '"result"' "$D/state.json" && break; sleep 0.1; done
 snap s4
 xdotool key Escape
@@ -111,17 +111,18 @@ TEST(TrainerInput, ClutchDepthReadoutTabAndResultAsATraineeUsesThem) {
   for (const char* hand : {"left", "right"})
     EXPECT_LE(distance(tool_of(s0, hand), tool_of(s1, hand)), 0.05) << hand;
 
+  // Tab: the other hand becomes the active one.
+  const std::string first = s1["active_hand"];
+  const std::string second = first == "left" ? "right" : "left";
+  EXPECT_EQ(s2["active_hand"], second) << "Tab switches the active hand";
+
   // Three clicks of the wheel: the active tool 0.3 mm lower, its readout too; the other still.
-  const std::string active = s1["active_hand"];
-  const std::string other = active == "left" ? "right" : "left";
-  const json& before = tool_of(s1, active);
-  const json& after = tool_of(s2, active);
-  ASSERT_TRUE(before["height_mm"].is_number() && after["height_mm"].is_number()) << s2.dump();
+  const json& before = tool_of(s2, second);
+  const json& after = tool_of(s3, second);
+  ASSERT_TRUE(before["height_mm"].is_number() && after["height_mm"].is_number()) << s3.dump();
   EXPECT_NEAR(after["height_mm"].get<double>() - before["height_mm"].get<double>(), -0.3, 0.02);
   EXPECT_NE(after["readout"], before["readout"]);
-  EXPECT_LE(distance(tool_of(s1, other), tool_of(s2, other)), 0.05);
-
-  EXPECT_EQ(s3["active_hand"], other) << "Tab switches the active hand";
+  EXPECT_LE(distance(tool_of(s2, first), tool_of(s3, first)), 0.05);
 
   // The Result table: formatted, whole, on screen.
   ASSERT_TRUE(s4.contains("result")) << s4.dump();
@@ -137,10 +138,12 @@ TEST(TrainerInput, ClutchDepthReadoutTabAndResultAsATraineeUsesThem) {
     a_range = a_range || target.find(" – ") != std::string::npos;
   }
   EXPECT_TRUE(a_range) << "the rhexis diameter's target reads as a range";
-  // The recorded track over every frame: no jump; the active hand moved by the wheel only.
+  // The recorded track over every frame: the hand the pointer drove while it jumped moved at most
+  // 0.05 mm in all; the other moved by the wheel only (0.3 mm; the scene's pose follows each 0.1 mm
+  // step with a small overshoot, about 0.02 mm a click in all, hence the margin).
   const json& m = result["metrics"];
-  EXPECT_LE(m[other + ".path_length_mm"].get<double>(), 0.05);
-  EXPECT_LE(m[active + ".path_length_mm"].get<double>(), 0.3 + 0.05);
+  EXPECT_LE(m[first + ".path_length_mm"].get<double>(), 0.05);
+  EXPECT_LE(m[second + ".path_length_mm"].get<double>(), 0.3 + 0.1);
   fs::remove_all(dir);
 }
 
