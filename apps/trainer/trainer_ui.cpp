@@ -270,7 +270,11 @@ void TrainerUi::result_panel(TrainerSession& session) {
       ImGui::TableNextColumn();
       ImGui::TextUnformatted(r.target.c_str());
       ImGui::TableNextColumn();
-      ImGui::TextColored(verdict, "%s / %s", r.points.c_str(), r.weight.c_str());
+      // Points: green in full, red when none (a term not measured has no verdict but no points).
+      const ImVec4 points = r.points == r.weight ? ImVec4(0.35f, 0.9f, 0.4f, 1.0f)
+                            : r.points == "0"    ? ImVec4(1.0f, 0.35f, 0.3f, 1.0f)
+                                                 : ImVec4(0.8f, 0.8f, 0.8f, 1.0f);
+      ImGui::TextColored(points, "%s / %s", r.points.c_str(), r.weight.c_str());
     }
     ImGui::EndTable();
   }
