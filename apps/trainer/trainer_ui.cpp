@@ -70,9 +70,11 @@ UiAction TrainerUi::draw(TrainerSession& session, render::Renderer& renderer,
   UiAction action = UiAction::None;
   // A drill that reached its end is finished once: its score and report appear.
   if (session.state() == TrainerState::Ended && !finished_) finish(session);
-  // The first start of each drill names its controls (F1 shows them again).
+  // The first start of each drill names its controls (F1 shows them again); not in the unattended
+  // runs, which nobody reads and whose frame rate is the steady view's.
+  const bool unattended = options_.screenshot || options_.stats || options_.soak;
   if (intro_seen_.insert(std::string(to_string(session.config().scenario.drill))).second)
-    controls_open_ = true;
+    controls_open_ = !unattended;
   if (snap && renderer.options().stereo == render::StereoMode::Mono)
     draw_height_labels(*snap, microscope, view_w, view_h);
   drill_panel(session, action);
@@ -180,7 +182,7 @@ void TrainerUi::live_panel(TrainerSession& session, double frame_ms,
     if (events_.size() > 12) events_.pop_back();
   }
   ImGui::SetNextWindowPos(ImVec2(10, 260), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(360, 300), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(360, 220), ImGuiCond_FirstUseEver);
   ImGui::Begin("Live");
   ImGui::Text("%s  %.1f / %.1f s", kStates[static_cast<size_t>(s.state)], s.sim_time_s,
               s.duration_s);
