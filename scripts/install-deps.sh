@@ -21,6 +21,8 @@ packages=(
   libglfw3-dev libepoxy-dev libimgui-dev   # trainer (later issues)
   xvfb mesa-utils libgl1-mesa-dri   # renderer tests: a virtual X display, Mesa's llvmpipe
   chromium               # headless check of the HTML report
+  fonts-dejavu-core      # the trainer panels' font: range and unit signs (≥ – °) (issue 24)
+  xdotool                # the trainer driven as a trainee would: synthetic pointer and keys (issue 24)
 )
 
 # Node.js and npm run the xAPI validator of the records tests (an npm package, issue 21). A

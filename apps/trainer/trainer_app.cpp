@@ -7,6 +7,7 @@
 #include <imgui.h>
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>  // the panels' rectangles, for the clutch
 
 #include <algorithm>
 #include <cstdio>
@@ -28,6 +29,7 @@
 #include "engine/render/offscreen.hpp"
 #include "engine/render/renderer.hpp"
 #include "procedures/scene/scene.hpp"
+#include "procedures/trainer/pointer_clutch.hpp"
 #include "procedures/trainer/trainer_session.hpp"
 
 namespace phaco::trainer {
@@ -67,11 +69,40 @@ struct Glfw {
 
 // Mouse, wheel, keys and gamepad → the session's DesktopInput (the main thread is its one writer).
 struct InputGlue {
-  double last_x = 0, last_y = 0;
-  bool have_last = false;
+  PointerClutch clutch;
   double wheel = 0;  // accumulated by the scroll callback
-  bool tab_down = false, space_down = false, r_down = false, g_down = false;
+  bool tab_down = false, space_down = false, r_down = false, g_down = false, f1_down = false;
+  int64_t ui_state_ns = 0;  // when --ui-state was last written
 };
+
+// Whether (x, y) px lies on a panel (any ImGui window shown last frame, popups included): there the
+// pointer works the panel, not the tool.
+bool over_panel(double x, double y) {
+  const ImVec2 p(static_cast<float>(x), static_cast<float>(y));
+  for (const ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
+    if (w->Active && !w->Hidden && w->Rect().Contains(p)) return true;
+  return false;
+}
+
+// The panels' font: DejaVu Sans (Debian's fonts-dejavu-core) has the range and unit signs
+// (≥ – ° µ) the Result table prints; without it ImGui's built-in font (ASCII and Latin-1).
+void load_font() {
+  static const ImWchar kRanges[] = {0x0020, 0x00FF, 0x2013, 0x2014, 0x2264, 0x2265, 0};
+  const char* const path = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+  if (std::filesystem::exists(path))
+    ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 14.0f, nullptr, kRanges);
+}
+
+void write_ui_state(const std::filesystem::path& file, const nlohmann::json& j) {
+  // Whole or not at all: a reader never sees half a file.
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << j.dump(2) << "\n";
+    if (!out) throw InputError(tmp.string() + ": cannot write the UI state");
+  }
+  std::filesystem::rename(tmp, file);
+}
 
 InputGlue* glue_of(GLFWwindow* w) {
   return static_cast<InputGlue*>(glfwGetWindowUserPointer(w));
@@ -149,10 +180,14 @@ int run_trainer(const TrainerOptions& o) {
   InputGlue glue;
   glfwSetWindowUserPointer(window, &glue);
   glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) { glue_of(w)->wheel += dy; });
+  // A key tapped between two frames (a slow software-rendered frame, or a synthetic key) still
+  // reads as pressed once: glfwGetKey keeps the press until it is read.
+  glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  if (o.ui) load_font();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330");
 
@@ -234,15 +269,23 @@ int run_trainer(const TrainerOptions& o) {
       const bool ui_has_mouse = o.ui && ImGui::GetIO().WantCaptureMouse;
       const bool ui_has_keys = o.ui && ImGui::GetIO().WantCaptureKeyboard;
 
-      // Input → DesktopInput (read by the haptic thread through the hands' devices).
+      // Input → DesktopInput (read by the haptic thread through the hands' devices). The clutch:
+      // the pointer drives the tool only over the view (inside the window, on no panel).
       DesktopInput& in = session->desktop();
       double x = 0, y = 0;
       glfwGetCursorPos(window, &x, &y);
-      if (glue.have_last && !ui_has_mouse) in.mouse_move(x - glue.last_x, y - glue.last_y);
-      glue.last_x = x, glue.last_y = y, glue.have_last = true;
-      if (glue.wheel != 0 && !ui_has_mouse) in.wheel(glue.wheel);
+      int win_w = 0, win_h = 0;
+      glfwGetWindowSize(window, &win_w, &win_h);
+      const bool in_view = x >= 0 && y >= 0 && x < win_w && y < win_h && !ui_has_mouse &&
+                           !(o.ui && over_panel(x, y));
+      const bool clutch_held = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS ||
+                               glfwGetKey(window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                               glfwGetKey(window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+      const auto [dx, dy] = clutch_step(glue.clutch, x, y, in_view, clutch_held);
+      if (dx != 0 || dy != 0) in.mouse_move(dx, dy);
+      if (glue.wheel != 0 && in_view) in.wheel(glue.wheel);
       glue.wheel = 0;
-      if (!ui_has_mouse) {
+      if (in_view) {
         in.mouse_buttons(glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS,
                          glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS);
       }
@@ -264,6 +307,7 @@ int run_trainer(const TrainerOptions& o) {
         if (pressed_once(window, GLFW_KEY_R, glue.r_down)) session->reset();
         if (pressed_once(window, GLFW_KEY_G, glue.g_down))
           renderer.options().guidance = !renderer.options().guidance;
+        if (pressed_once(window, GLFW_KEY_F1, glue.f1_down)) ui.toggle_controls();
       }
 
       // The view: the newest snapshot the simulation published.
@@ -297,8 +341,8 @@ int run_trainer(const TrainerOptions& o) {
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
-        if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back()) ==
-            UiAction::Restart) {
+        if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back(),
+                    snap, fb_w, fb_h) == UiAction::Restart) {
           config = ui.config();
           auto next = std::make_unique<TrainerSession>(config);
           next->take_unsaved_from(*session);  // drills the database refused stay kept
@@ -307,6 +351,10 @@ int run_trainer(const TrainerOptions& o) {
         }
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (o.ui_state && now_ns() - glue.ui_state_ns > 100'000'000) {
+          write_ui_state(*o.ui_state, ui.state_json(*session, session->newest_snapshot()));
+          glue.ui_state_ns = now_ns();
+        }
       }
       glfwSwapBuffers(window);
       frames.tick();

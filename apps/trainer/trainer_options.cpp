@@ -23,6 +23,7 @@ usage:
   phaco-trainer ... --screenshot OUT.png [--after SECONDS] [--no-ui]
   phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
   phaco-trainer ... --soak OUT.json [--soak-for SECONDS]
+  phaco-trainer ... --ui-state OUT.json
   phaco-trainer --help
 
   --drill       corneal_incision | capsulorhexis | phaco_sculpting | nucleus_removal (default
@@ -48,10 +49,16 @@ usage:
                 scripted hands unless --left/--right say otherwise) for --soak-for wall seconds
                 (default 60), then write per-drill resident memory, live GL objects and the
                 haptic period as JSON, exit (phaco-perf soak charts and checks it)
+  --ui-state    while running, rewrite OUT.json ten times a second with what the trainee sees:
+                the active hand, each tip's height readout, the Result table (for tests that
+                drive the window with xdotool)
 
-controls: mouse moves the selected hand's tip, wheel = depth, left button = grip / ultrasound,
-right button = aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers =
-grip/pedal, bumpers = deeper); Space pauses; R restarts; G toggles the guidance cues; Esc quits.
+controls: mouse moves the selected hand's tip, only while the pointer is over the view (over a
+panel or outside the window both tools stay put; hold the middle button or Shift to move the
+pointer alone), wheel = depth (0.1 mm a click), left button = grip / ultrasound, right button =
+aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers = grip/pedal,
+bumpers = deeper); Space pauses; R restarts; G toggles the guidance cues; F1 shows the controls;
+Esc quits. The label by each tip is its height above the tissue under it.
 Exit codes: 0 done, 2 bad input (named), 3 no display or OpenGL 3.3, or an unattended run timed out.
 )";
 
@@ -88,9 +95,10 @@ std::filesystem::path drill_scenario(const std::string& drill) {
 TrainerOptions parse_options(const std::vector<std::string>& raw) {
   const cli::Args a = cli::parse_args(
       "command line", raw,
-      {"--drill", "--scenario", "--difficulty", "--left", "--right", "--trainee", "--db",
-       "--sync-to", "--size", "--threads", "--cache-dir", "--screenshot", "--after", "--stats",
-       "--stats-after", "--duration", "--timeout", "--soak", "--soak-for"},
+      {"--drill",     "--scenario",   "--difficulty", "--left",     "--right",
+       "--trainee",   "--db",         "--sync-to",    "--size",     "--threads",
+       "--cache-dir", "--screenshot", "--after",      "--stats",    "--stats-after",
+       "--duration",  "--timeout",    "--soak",       "--soak-for", "--ui-state"},
       {"--stereo", "--no-guidance", "--no-ui", "--no-render"}, "phaco-trainer --help");
   if (!a.positional.empty()) {
     throw InputError("unexpected argument '" + a.positional[0] +
@@ -132,6 +140,7 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   if (auto v = a.option("--screenshot")) o.screenshot = *v;
   if (auto v = a.option("--after")) o.after_s = number("--after", *v, 0, 3600);
   if (auto v = a.option("--stats")) o.stats = *v;
+  if (auto v = a.option("--ui-state")) o.ui_state = *v;
   if (auto v = a.option("--stats-after")) o.stats_after_s = number("--stats-after", *v, 0.5, 3600);
   if (auto v = a.option("--timeout")) o.timeout_s = number("--timeout", *v, 1, 86400);
   o.stereo = a.flag("--stereo");
@@ -140,6 +149,8 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   o.render = !a.flag("--no-render");
   if (!o.render && !o.stats) throw InputError("--no-render: only with --stats (the baseline)");
   if (o.screenshot && o.stats) throw InputError("--screenshot or --stats, not both");
+  if (o.ui_state && !o.ui)
+    throw InputError("--ui-state: not with --no-ui or --screenshot (it reports the panels)");
   if (a.option("--after") && !o.screenshot) throw InputError("--after: only with --screenshot");
   if (a.option("--stats-after") && !o.stats) throw InputError("--stats-after: only with --stats");
   if (auto v = a.option("--soak")) {

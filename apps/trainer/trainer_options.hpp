@@ -36,6 +36,8 @@ struct TrainerOptions {
   // `soak_for_s` wall seconds, then the per-drill samples (memory, GL objects, haptic period) as
   // JSON to `soak` (apps/trainer/trainer_soak.hpp).
   std::optional<std::filesystem::path> soak;
+  // What the trainee sees (TrainerUi::state_json), rewritten ten times a second while running.
+  std::optional<std::filesystem::path> ui_state;
   double soak_for_s = 60.0;
 };
 

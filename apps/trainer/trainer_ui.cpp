@@ -4,15 +4,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
+#include "apps/trainer/trainer_overlays.hpp"
 #include "engine/core/error.hpp"
 #include "engine/records/background_sync.hpp"
 #include "engine/records/record_location.hpp"
 #include "engine/records/record_run.hpp"
 #include "engine/records/records.hpp"
 #include "procedures/report/html_report.hpp"
+#include "procedures/report/report_fields.hpp"
 #include "procedures/scene/scene.hpp"
 
 namespace phaco::trainer {
@@ -22,6 +25,8 @@ namespace {
 constexpr std::array<const char*, 4> kDrills = {"corneal_incision", "capsulorhexis",
                                                 "phaco_sculpting", "nucleus_removal"};
 constexpr std::array<const char*, 3> kDevices = {"desktop", "scripted", "track"};
+constexpr std::array<const char*, 4> kStates = {"idle", "running", "paused",
+                                                "ended"};  // TrainerState
 
 // Events a trainee must notice at once (seed 004: warn before the tear runs out).
 bool is_warning(const std::string& kind) {
@@ -60,15 +65,24 @@ void TrainerUi::refresh_levels() {
 }
 
 UiAction TrainerUi::draw(TrainerSession& session, render::Renderer& renderer,
-                         render::Microscope& microscope, double frame_ms) {
+                         render::Microscope& microscope, double frame_ms,
+                         const render::RenderSnapshot* snap, int view_w, int view_h) {
   UiAction action = UiAction::None;
   // A drill that reached its end is finished once: its score and report appear.
   if (session.state() == TrainerState::Ended && !finished_) finish(session);
+  // The first start of each drill names its controls (F1 shows them again); not in the unattended
+  // runs, which nobody reads and whose frame rate is the steady view's.
+  const bool unattended = options_.screenshot || options_.stats || options_.soak;
+  if (intro_seen_.insert(std::string(to_string(session.config().scenario.drill))).second)
+    controls_open_ = !unattended;
+  if (snap && renderer.options().stereo == render::StereoMode::Mono)
+    draw_height_labels(*snap, microscope, view_w, view_h);
   drill_panel(session, action);
-  live_panel(session, frame_ms);
+  live_panel(session, frame_ms, snap);
   result_panel(session);
   history_panel();
   view_panel(renderer, microscope);
+  if (controls_open_) controls_window(session.config().scenario, controls_open_);
   return action;
 }
 
@@ -83,6 +97,9 @@ void TrainerUi::finish(TrainerSession& session) {
       message_ = report_.contains("record_id") ? "stored as record " + report_["record_id"].dump()
                                                : std::string("finished (not stored: no trainee)");
     if (sync_ && report_.contains("record_id")) sync_->request();
+    rows_.clear();
+    for (const report::fields::Term& t : report::fields::read_run(report_).terms)
+      rows_.push_back(report::term_text(t));
   } catch (const InputError& e) {
     message_ = e.what();
   }
@@ -90,7 +107,7 @@ void TrainerUi::finish(TrainerSession& session) {
 
 void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("Drill");
   ImGui::InputText("trainee", trainee_, sizeof trainee_);
   if (ImGui::Combo("drill", &drill_index_, kDrills.data(), static_cast<int>(kDrills.size()))) {
@@ -142,11 +159,14 @@ void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
     }
   }
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
-  ImGui::TextDisabled("Tab: other hand  Space: pause  R: restart  G: guidance");
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+  ImGui::TextWrapped("Tab: other hand  Space: pause  R: restart  G: guidance  F1: controls");
+  ImGui::PopStyleColor();
   ImGui::End();
 }
 
-void TrainerUi::live_panel(TrainerSession& session, double frame_ms) {
+void TrainerUi::live_panel(TrainerSession& session, double frame_ms,
+                           const render::RenderSnapshot* snap) {
   const TrainerStatus s = session.status();
   polled_.clear();
   session.poll_events(polled_);
@@ -162,16 +182,33 @@ void TrainerUi::live_panel(TrainerSession& session, double frame_ms) {
     if (events_.size() > 12) events_.pop_back();
   }
   ImGui::SetNextWindowPos(ImVec2(10, 260), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(360, 220), ImGuiCond_FirstUseEver);
   ImGui::Begin("Live");
-  static constexpr std::array<const char*, 4> kStates = {"idle", "running", "paused", "ended"};
   ImGui::Text("%s  %.1f / %.1f s", kStates[static_cast<size_t>(s.state)], s.sim_time_s,
               s.duration_s);
   ImGui::Text("simulation %.0f Hz   render %.0f fps", s.sim_rate_hz,
               frame_ms > 0 ? 1000.0 / frame_ms : 0.0);
   ImGui::Text("haptics p50 %.0f us  p99 %.0f us", s.haptic_period_p50_us, s.haptic_period_p99_us);
-  ImGui::Text("mouse drives the %s hand",
-              session.desktop().selected() == Hand::Left ? "left" : "right");
+  // Each tool: the active one as a badge in its hand's colour, its height readout in colour.
+  const Hand active = session.desktop().selected();
+  if (snap) {
+    for (const render::ToolView& t : snap->tools) {
+      const std::string name =
+          std::string(to_string(t.hand)) + " " + std::string(to_string(t.kind));
+      if (t.hand == active) {
+        ImGui::PushStyleColor(ImGuiCol_Button, hand_colour(t.hand));
+        ImGui::PushStyleColor(ImGuiCol_ButtonHovered, hand_colour(t.hand));
+        ImGui::PushStyleColor(ImGuiCol_ButtonActive, hand_colour(t.hand));
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0, 0, 0, 1));
+        ImGui::SmallButton((name + " (mouse)").c_str());
+        ImGui::PopStyleColor(4);
+      } else {
+        ImGui::TextColored(hand_colour(t.hand), "%s", name.c_str());
+      }
+      ImGui::SameLine();
+      ImGui::TextColored(height_colour(t.height_mm), "%s", height_text(t).c_str());
+    }
+  }
   ImGui::Separator();
   for (const Shown& e : events_) {
     if (e.warning) {
@@ -185,9 +222,13 @@ void TrainerUi::live_panel(TrainerSession& session, double frame_ms) {
 
 void TrainerUi::result_panel(TrainerSession& session) {
   if (!finished_ || !report_.is_object()) return;
-  ImGui::SetNextWindowPos(ImVec2(options_.width - 390.0f, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
-  ImGui::Begin("Result");
+  // Sized to its table, so no name is cut; kept inside the window.
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(display.x - 10.0f, 10), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+  ImGui::Begin("Result", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  const ImVec2 at = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  result_on_screen_ = at.x >= 0 && at.y >= 0 && at.x + size.x <= display.x + 0.5f &&
+                      at.y + size.y <= display.y + 0.5f;
   // Drills whose record the database refused stay in memory until they are stored.
   if (session.unsaved_count() > 0) {
     ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.3f, 1.0f), "%zu finished drill(s) not stored",
@@ -205,23 +246,37 @@ void TrainerUi::result_panel(TrainerSession& session) {
   }
   const auto& m = report_.value("metrics", nlohmann::json::object());
   ImGui::Text("score %.1f / 100", m.value("score", 0.0));
-  if (ImGui::BeginTable("terms", 4, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {
+  // The terms as the HTML report writes them (procedures/report/term_text): names with units,
+  // targets as ranges, met in green and missed in red.
+  row_fits_.assign(rows_.size(), true);
+  constexpr ImGuiTableFlags kFlags =
+      ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit;
+  if (ImGui::BeginTable("terms", 4, kFlags)) {
     ImGui::TableSetupColumn("metric");
     ImGui::TableSetupColumn("value");
     ImGui::TableSetupColumn("target");
     ImGui::TableSetupColumn("points");
     ImGui::TableHeadersRow();
-    for (const auto& t : report_.value("score_terms", nlohmann::json::array())) {
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      const report::TermText& r = rows_[i];
+      const ImVec4 verdict = !r.met   ? ImVec4(0.8f, 0.8f, 0.8f, 1.0f)
+                             : *r.met ? ImVec4(0.35f, 0.9f, 0.4f, 1.0f)
+                                      : ImVec4(1.0f, 0.35f, 0.3f, 1.0f);
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
-      ImGui::TextUnformatted(t.value("metric", "").c_str());
+      row_fits_[i] =
+          ImGui::CalcTextSize(r.label.c_str()).x <= ImGui::GetContentRegionAvail().x + 0.5f;
+      ImGui::TextUnformatted(r.label.c_str());
       ImGui::TableNextColumn();
-      ImGui::TextUnformatted(
-          t["value"].is_number() ? std::to_string(t["value"].get<double>()).c_str() : "-");
+      ImGui::TextColored(verdict, "%s", r.value.c_str());
       ImGui::TableNextColumn();
-      ImGui::TextUnformatted(t.value("target", nlohmann::json::object()).dump().c_str());
+      ImGui::TextUnformatted(r.target.c_str());
       ImGui::TableNextColumn();
-      ImGui::Text("%.1f / %.0f", t.value("points", 0.0), t.value("weight", 0.0));
+      // Points: green in full, red when none (a term not measured has no verdict but no points).
+      const ImVec4 points = r.points == r.weight ? ImVec4(0.35f, 0.9f, 0.4f, 1.0f)
+                            : r.points == "0"    ? ImVec4(1.0f, 0.35f, 0.3f, 1.0f)
+                                                 : ImVec4(0.8f, 0.8f, 0.8f, 1.0f);
+      ImGui::TextColored(points, "%s / %s", r.points.c_str(), r.weight.c_str());
     }
     ImGui::EndTable();
   }
@@ -279,6 +334,45 @@ void TrainerUi::view_panel(render::Renderer& renderer, render::Microscope& micro
   if (ImGui::Checkbox("side-by-side stereo", &stereo))
     renderer.options().stereo = stereo ? render::StereoMode::SideBySide : render::StereoMode::Mono;
   ImGui::End();
+}
+
+nlohmann::json TrainerUi::state_json(TrainerSession& session,
+                                     const render::RenderSnapshot* snap) const {
+  const TrainerStatus st = session.status();
+  nlohmann::json j;
+  j["state"] = kStates[static_cast<size_t>(st.state)];
+  j["sim_time_s"] = st.sim_time_s;
+  j["drill"] = std::string(to_string(session.config().scenario.drill));
+  j["active_hand"] = std::string(to_string(session.desktop().selected()));
+  j["controls_shown"] = controls_open_;
+  j["tools"] = nlohmann::json::array();
+  if (snap) {
+    for (const render::ToolView& t : snap->tools) {
+      j["tools"].push_back({{"hand", std::string(to_string(t.hand))},
+                            {"tool", std::string(to_string(t.kind))},
+                            {"tip_mm", {t.tip_mm.x(), t.tip_mm.y(), t.tip_mm.z()}},
+                            {"height_mm", std::isfinite(t.height_mm) ? nlohmann::json(t.height_mm)
+                                                                     : nlohmann::json()},
+                            {"readout", height_text(t)},
+                            {"selected", t.selected}});
+    }
+  }
+  if (finished_ && report_.is_object()) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      const report::TermText& r = rows_[i];
+      rows.push_back({{"metric", r.label},
+                      {"value", r.value},
+                      {"target", r.target},
+                      {"points", r.points + " / " + r.weight},
+                      {"met", r.met ? nlohmann::json(*r.met) : nlohmann::json()},
+                      {"name_fits", i < row_fits_.size() && row_fits_[i]}});
+    }
+    j["result"] = {{"rows", rows},
+                   {"on_screen", result_on_screen_},
+                   {"metrics", report_.value("metrics", nlohmann::json::object())}};
+  }
+  return j;
 }
 
 }  // namespace phaco::trainer

@@ -6,11 +6,13 @@
 // the records database; the microscope's zoom and focus, guidance and stereo.
 #include <deque>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "apps/trainer/trainer_options.hpp"
 #include "engine/render/renderer.hpp"
+#include "procedures/report/term_text.hpp"
 #include "procedures/trainer/trainer_session.hpp"
 
 namespace phaco {
@@ -26,9 +28,14 @@ class TrainerUi {
   TrainerUi(const TrainerOptions& options, const TrainerConfig& config);
 
   // One frame of panels (between ImGui::NewFrame and ImGui::Render). `frame_ms`: the last
-  // render frame's duration.
+  // render frame's duration; `snap`: the snapshot drawn this frame (may be null), in a view of
+  // view_w × view_h px.
   UiAction draw(TrainerSession& session, render::Renderer& renderer, render::Microscope& microscope,
-                double frame_ms);
+                double frame_ms, const render::RenderSnapshot* snap, int view_w, int view_h);
+  void toggle_controls() { controls_open_ = !controls_open_; }  // F1
+  // What a trainee sees, as JSON (--ui-state; the tests read it): the active hand, each tool's
+  // tip and height readout, whether the controls are shown, the Result table as shown.
+  nlohmann::json state_json(TrainerSession& session, const render::RenderSnapshot* snap) const;
   // The configuration the user chose (after Restart).
   const TrainerConfig& config() const { return config_; }
   // The background upload to a centre (--sync-to), asked after each stored drill; may be null.
@@ -37,7 +44,7 @@ class TrainerUi {
  private:
   void finish(TrainerSession& session);  // the drill's report (and record), once
   void drill_panel(TrainerSession& session, UiAction& action);
-  void live_panel(TrainerSession& session, double frame_ms);
+  void live_panel(TrainerSession& session, double frame_ms, const render::RenderSnapshot* snap);
   void result_panel(TrainerSession& session);
   void history_panel();
   void view_panel(render::Renderer& renderer, render::Microscope& microscope);
@@ -63,6 +70,11 @@ class TrainerUi {
   bool finished_ = false;
   nlohmann::json history_ = nlohmann::json::array();
   BackgroundSync* sync_ = nullptr;
+  std::set<std::string> intro_seen_;  // drills whose controls were shown on their first start
+  bool controls_open_ = false;
+  std::vector<report::TermText> rows_;  // the Result table, formatted once per finish
+  std::vector<bool> row_fits_;          // each row's metric name shown whole (last frame)
+  bool result_on_screen_ = true;        // the Result panel lies inside the window (last frame)
 };
 
 }  // namespace phaco::trainer

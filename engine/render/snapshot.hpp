@@ -8,6 +8,7 @@
 // allocates only when a body's element count grows, i.e. when its topology changed).
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,9 @@ struct BodyView {
   std::vector<uint8_t> piece;
 };
 
+// The tissue under a tool's tip, for the trainer's depth cue (issue 24 item 2).
+enum class Tissue : uint8_t { None, Cornea, Capsule, Lens };
+
 struct ToolView {
   ToolKind kind = ToolKind::Forceps;
   Hand hand = Hand::Right;
@@ -52,6 +56,10 @@ struct ToolView {
   double pedal = 0;              // 0..3 (the phaco tip glows at 3: ultrasound on)
   bool selected = false;         // the hand the mouse drives (mouse/keyboard input)
   bool in_contact = false;       // touching tissue (drawn with a contact ring)
+  // The tip's height above the tissue under it along the view axis, mm (< 0: that deep in it);
+  // NaN over no tissue (procedures/trainer/tip_height.hpp).
+  double height_mm = std::numeric_limits<double>::quiet_NaN();
+  Tissue under = Tissue::None;
 };
 
 // Guidance cues drawn as overlays (seed 000 Fig. 8; the drill file's guidance, docs/drills.md).

@@ -20,6 +20,7 @@
 #include "engine/core/error.hpp"
 #include "engine/plot/chart.hpp"
 #include "procedures/report/report_fields.hpp"
+#include "procedures/report/term_text.hpp"
 
 namespace phaco::report {
 
@@ -36,34 +37,6 @@ using namespace fields;  // the report's fields, read and checked (report_fields
 
 std::string escape(const std::string& s) {
   return escape_markup(s);
-}
-
-std::optional<double> as_number(const json& j) {
-  if (j.is_number()) return j.get<double>();
-  if (j.is_boolean()) return j.get<bool>() ? 1.0 : 0.0;
-  return std::nullopt;
-}
-
-std::string band_text(const Band& b) {
-  if (b.min && b.max) return fmt(*b.min) + " – " + fmt(*b.max);
-  if (b.min) return "≥ " + fmt(*b.min);
-  if (b.max) return "≤ " + fmt(*b.max);
-  return "—";
-}
-
-bool within(double v, const Band& b) {
-  const auto slack = [](double bound) { return 1e-9 * (1 + std::fabs(bound)); };
-  return (!b.min || v >= *b.min - slack(*b.min)) && (!b.max || v <= *b.max + slack(*b.max));
-}
-
-std::string target_text(const json& t) {
-  if (t.is_object()) {
-    Band b;
-    if (const json* lo = member(t, "min"); lo && lo->is_number()) b.min = lo->get<double>();
-    if (const json* hi = member(t, "max"); hi && hi->is_number()) b.max = hi->get<double>();
-    if (b.min || b.max) return band_text(b);
-  }
-  return t.is_null() ? "—" : scalar_text(t);
 }
 
 std::string note(const std::string& what) {
@@ -429,12 +402,12 @@ std::string score_section(const Run& r) {
         t.weight && *t.weight > 0 && t.points ? std::clamp(*t.points / *t.weight, 0.0, 1.0) : 0;
     char width[16];
     std::snprintf(width, sizeof width, "%.0f%%", 100 * frac);
-    out +=
-        "<tr><td>" + escape(t.metric.empty() ? "(unnamed)" : t.metric) + "</td><td class=\"num\">" +
-        escape(scalar_text(t.value)) + "</td><td>" + escape(target_text(t.target)) +
-        "</td><td class=\"num\">" + (t.weight ? fmt(*t.weight) : "—") + "</td><td class=\"num\">" +
-        (t.points ? fmt(*t.points) : "—") +
-        "</td><td><div class=\"bar\"><div style=\"width:" + width + "\"></div></div></td></tr>\n";
+    const TermText row = term_text(t);  // as the trainer's Result panel shows it
+    out += "<tr><td>" + escape(row.label) + "</td><td class=\"num\">" + escape(row.value) +
+           "</td><td>" + escape(row.target) + "</td><td class=\"num\">" + row.weight +
+           "</td><td class=\"num\">" + row.points +
+           "</td><td><div class=\"bar\"><div style=\"width:" + width +
+           "\"></div></div></td></tr>\n";
     if (t.points) sum += *t.points;
     if (t.weight) weights += *t.weight;
   }
@@ -465,20 +438,24 @@ std::string metrics_section(const Run& r) {
     }
     const std::optional<double> v = as_number(value);
     if (!v) {
-      row(name, scalar_text(value), band_text(t->second), "not a number");
+      row(name, scalar_text(value), band_text(t->second, metric_unit(name)), "not a number");
     } else if (within(*v, t->second)) {
       ++met;
-      row(name, scalar_text(value), band_text(t->second), "<span class=\"met\">met</span>");
+      row(name, scalar_text(value), band_text(t->second, metric_unit(name)),
+          "<span class=\"met\">met</span>");
     } else {
       ++missed;
-      row(name, scalar_text(value), band_text(t->second), "<span class=\"missed\">missed</span>");
+      row(name, scalar_text(value), band_text(t->second, metric_unit(name)),
+          "<span class=\"missed\">missed</span>");
     }
   }
   for (const auto& [name, band] : r.targets) {
     const bool measured = std::any_of(r.metrics.begin(), r.metrics.end(),
                                       [&](const auto& m) { return m.first == name; });
     if (!measured)
-      row(name, "not measured", band_text(band), "<span class=\"missed\">missed</span>"), ++missed;
+      row(name, "not measured", band_text(band, metric_unit(name)),
+          "<span class=\"missed\">missed</span>"),
+          ++missed;
   }
   if (r.has_targets)
     out += "<p>" + std::to_string(met) + " target(s) met, " + std::to_string(missed) +

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <optional>
 #include <vector>
 
 #include "components/body.hpp"
@@ -15,6 +16,7 @@
 #include "procedures/scene/lens_sculpting.hpp"
 #include "procedures/scene/scene.hpp"
 #include "procedures/scene/tool_ports.hpp"
+#include "procedures/trainer/tip_height.hpp"
 #include "systems/simplex/simplex_surface.hpp"
 
 namespace phaco {
@@ -48,7 +50,9 @@ struct SnapshotFillCache {
   std::vector<uint8_t> face_was_external;         // fragments lens, per face id, at first fill
   std::vector<Vec3> ports;                        // guidance ports when no ports record
   bool ports_made = false;
-  float reflex_attenuation = -1;  // lens, 1/mm; set at the first fill
+  float reflex_attenuation = -1;        // lens, 1/mm; set at the first fill
+  std::optional<eye::EyeGeometry> eye;  // the depth cue's layout; set at the first fill
+  bool has_capsule = false;
 };
 
 // How much each mm of the sculptable lens dims the red reflex (render::BodyView): a harder, browner
@@ -341,6 +345,10 @@ void fill_snapshot(Scene& scene, render::RenderSnapshot& snap) {
 
   // Drawn opaque first, translucent last: the renderer sorts by look if it needs more.
   snap.tools.resize(scene.tools.size());
+  if (!cache->eye) {
+    cache->eye = eye::eye_geometry(scene.params);
+    cache->has_capsule = scene.body(BodyPart::Capsule).has_value();
+  }
   for (size_t k = 0; k < scene.tools.size(); ++k) {
     const Entity e = scene.tools[k];
     const Tool& tool = w.at<Tool>(e);
@@ -355,6 +363,9 @@ void fill_snapshot(Scene& scene, render::RenderSnapshot& snap) {
     tv.selected = false;  // the trainer session marks the desktop input's hand
     const ToolGrasp* g = w.get<ToolGrasp>(e);
     tv.in_contact = g && g->capsule.holding();
+    const TipHeight h = tip_height(*cache->eye, cache->has_capsule, pose.pos);
+    tv.height_mm = h.height_mm;
+    tv.under = h.under;
   }
   fill_guidance(scene, snap, *cache);
   const PortsRecord* ports = ports_record(scene);

@@ -227,12 +227,13 @@ TEST(TrainerCliArgs, HelpAndBadInput) {
   EXPECT_EQ(help.code, 0);
   EXPECT_NE(help.output.find("--screenshot"), std::string::npos);
   EXPECT_NE(help.output.find("--difficulty"), std::string::npos);
-  for (const auto& [args, message] : std::array<std::pair<const char*, const char*>, 5>{{
+  for (const auto& [args, message] : std::array<std::pair<const char*, const char*>, 6>{{
            {"--drill vitrectomy", "--drill: unknown drill 'vitrectomy'"},
            {"--size 12", "--size: expected WxH"},
            {"--bogus", "unknown option '--bogus'"},
            {"--drill capsulorhexis --difficulty nightmare", "unknown level 'nightmare'"},
            {"--scenario /nonexistent.json", "/nonexistent.json: scenario file not found"},
+           {"--ui-state /tmp/never.json --no-ui", "--ui-state: not with --no-ui"},
        }}) {
     // Bad input is refused before any window opens: no display needed.
     const ShellResult r = shell("env -u DISPLAY " + std::string(PHACO_TRAINER_BIN) + " " + args);

@@ -13,15 +13,12 @@
 #include "procedures/scene/lens_sculpting.hpp"
 #include "procedures/trainer/snapshot_fill.hpp"
 #include "tests/support/scene_run.hpp"
+#include "tests/support/snapshot_view.hpp"
 
 namespace phaco {
 namespace {
 
-const render::BodyView* find(const render::RenderSnapshot& s, const std::string& name) {
-  for (const auto& b : s.bodies)
-    if (b.name == name) return &b;
-  return nullptr;
-}
+using test::find_view;
 
 void expect_well_formed(const render::RenderSnapshot& s) {
   for (const auto& b : s.bodies) {
@@ -51,12 +48,12 @@ TEST(SnapshotFill, CapsulorhexisBodiesToolsGuidanceAndTheCutEdges) {
   fill_snapshot(*scene, snap);
   expect_well_formed(snap);
   ASSERT_EQ(snap.bodies.size(), 4u);  // cornea, capsule, iris, lens_surface
-  const auto* capsule = find(snap, "capsule");
+  const auto* capsule = find_view(snap, "capsule");
   ASSERT_NE(capsule, nullptr);
   EXPECT_EQ(capsule->look, render::Look::Capsule);
-  EXPECT_EQ(find(snap, "cornea")->look, render::Look::Cornea);
-  EXPECT_EQ(find(snap, "iris")->look, render::Look::Iris);
-  EXPECT_EQ(find(snap, "lens_surface")->look, render::Look::LensSurface);
+  EXPECT_EQ(find_view(snap, "cornea")->look, render::Look::Cornea);
+  EXPECT_EQ(find_view(snap, "iris")->look, render::Look::Iris);
+  EXPECT_EQ(find_view(snap, "lens_surface")->look, render::Look::LensSurface);
   EXPECT_GT(capsule->tris.size(), 300u);
   const size_t rim_edges = capsule->edges.size() / 2;
   EXPECT_GT(rim_edges, 20u) << "the uncut capsule's open edges are its rim";
@@ -72,7 +69,7 @@ TEST(SnapshotFill, CapsulorhexisBodiesToolsGuidanceAndTheCutEdges) {
   const uint32_t* tris = capsule->tris.data();
   step(*scene);
   fill_snapshot(*scene, snap);
-  capsule = find(snap, "capsule");
+  capsule = find_view(snap, "capsule");
   EXPECT_EQ(capsule->topology_version, v0);
   EXPECT_EQ(capsule->xyz.data(), xyz);
   EXPECT_EQ(capsule->tris.data(), tris);
@@ -89,7 +86,7 @@ TEST(SnapshotFill, CapsulorhexisBodiesToolsGuidanceAndTheCutEdges) {
   for (uint64_t f = scene->frame; f < s.frame_count(); ++f) step(*scene);
   fill_snapshot(*scene, snap);
   expect_well_formed(snap);
-  capsule = find(snap, "capsule");
+  capsule = find_view(snap, "capsule");
   EXPECT_NE(capsule->topology_version, v0) << "the cut changed the capsule's triangles";
   EXPECT_GT(capsule->edges.size() / 2, rim_edges + 20) << "the rhexis edge is an open edge";
 }
@@ -102,8 +99,8 @@ TEST(SnapshotFill, SculptedTetLensShowsInteriorFaces) {
   render::RenderSnapshot snap;
   fill_snapshot(*scene, snap);
   expect_well_formed(snap);
-  const auto* lens = find(snap, "lens");
-  const auto* interior = find(snap, "lens.interior");
+  const auto* lens = find_view(snap, "lens");
+  const auto* interior = find_view(snap, "lens.interior");
   ASSERT_NE(lens, nullptr);
   ASSERT_NE(interior, nullptr);
   EXPECT_EQ(lens->look, render::Look::LensSurface);
@@ -124,8 +121,8 @@ TEST(SnapshotFill, SculptedTetLensShowsInteriorFaces) {
   for (uint32_t t : hit) remove_tet(ls.topology, t);
   fill_snapshot(*scene, snap);
   expect_well_formed(snap);
-  lens = find(snap, "lens");
-  interior = find(snap, "lens.interior");
+  lens = find_view(snap, "lens");
+  interior = find_view(snap, "lens.interior");
   EXPECT_LT(lens->tris.size(), outer0);
   EXPECT_GT(interior->tris.size(), 0u) << "the faces under the removed tets are exposed";
   EXPECT_NE(lens->topology_version, v0);
@@ -146,10 +143,10 @@ TEST(SnapshotFill, FragmentLensShowsItsSimplexBoundary) {
   render::RenderSnapshot snap;
   fill_snapshot(*scene, snap);
   expect_well_formed(snap);
-  const auto* lens = find(snap, "lens");
+  const auto* lens = find_view(snap, "lens");
   ASSERT_NE(lens, nullptr);
   EXPECT_GT(lens->tris.size(), 100u);
-  EXPECT_EQ(find(snap, "lens.interior")->tris.size(), 0u);
+  EXPECT_EQ(find_view(snap, "lens.interior")->tris.size(), 0u);
 
   LensFragments& lf = scene->world.at<LensFragments>(*scene->body(BodyPart::Lens));
   std::vector<uint32_t> cut;
@@ -161,7 +158,7 @@ TEST(SnapshotFill, FragmentLensShowsItsSimplexBoundary) {
   lens::remove_lens_cells(lf.lens, cut, stats);
   fill_snapshot(*scene, snap);
   expect_well_formed(snap);
-  EXPECT_GT(find(snap, "lens.interior")->tris.size(), 0u) << "a trench exposes the inside";
+  EXPECT_GT(find_view(snap, "lens.interior")->tris.size(), 0u) << "a trench exposes the inside";
 }
 
 }  // namespace
