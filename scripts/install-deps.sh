@@ -21,6 +21,8 @@ packages=(
   libglfw3-dev libepoxy-dev libimgui-dev   # trainer (later issues)
   xvfb mesa-utils libgl1-mesa-dri   # renderer tests: a virtual X display, Mesa's llvmpipe
   chromium               # headless check of the HTML report
+  dpkg-dev lintian desktop-file-utils help2man   # the Debian package and its checks (issue 23)
+  strace                 # scripts/check-package.sh: the unpacked programs never open the source tree
 )
 
 # Node.js and npm run the xAPI validator of the records tests (an npm package, issue 21). A
