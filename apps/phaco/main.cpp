@@ -26,8 +26,8 @@ usage:
       (DB, default $PHACO_DB, else $XDG_DATA_HOME/openphaco/records.sqlite, by default
       ~/.local/share/openphaco/records.sqlite; docs/records.md).
       Any DB may be an SQLite file or a postgresql:// URI (a training centre's server).
-      --difficulty picks a level of the drill file (data/drills/<drill>.json, e.g. standard,
-      easy, hard; docs/drills.md) instead of the scenario's.
+      --difficulty picks a level of the drill file (drills/<drill>.json in the data folder,
+      e.g. standard, easy, hard; docs/drills.md) instead of the scenario's.
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
                  [--record DB --trainee NAME]
