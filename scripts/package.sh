@@ -6,7 +6,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${PHACO_BUILD_DIR:-$root/build/release}"
-PHACO_BUILD_DIR="$build" "$root/scripts/build.sh" "$@"
+PHACO_BUILD_DIR="$build" "$root/scripts/build.sh" "$@" >&2  # stdout: the package path alone
 rm -f "$build"/package/openphaco_*.deb
 (cd "$build" && cpack -G DEB --config CPackConfig.cmake >/dev/null)
 ls "$build"/package/openphaco_*.deb
