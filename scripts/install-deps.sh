@@ -23,6 +23,8 @@ packages=(
   chromium               # headless check of the HTML report
   fonts-dejavu-core      # the trainer panels' font: range and unit signs (≥ – °) (issue 24)
   xdotool                # the trainer driven as a trainee would: synthetic pointer and keys (issue 24)
+  dpkg-dev lintian desktop-file-utils help2man   # the Debian package and its checks (issue 23)
+  strace                 # scripts/check-package.sh: the unpacked programs never open the source tree
 )
 
 # Node.js and npm run the xAPI validator of the records tests (an npm package, issue 21). A

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's second command (and what .ci/run calls): installs what is needed, checks every C++
 # file against .clang-format, builds, starts a throwaway PostgreSQL server and the xAPI validator
-# for the records tests, and runs every test; then builds the ASan+UBSan configuration and runs every test again under it
+# for the records tests, and runs every test, the perf harness's quick sweep and soak, and checks the
+# Debian package (scripts/check-package.sh); then builds the ASan+UBSan configuration and runs every test again under it
 # (skip that with PHACO_SKIP_SANITIZERS=1 for a quick local run), and the haptic tests (the 1 kHz
 # loop, the lock-free handoff, the devices, the session) under ThreadSanitizer. TSan runs only those:
 # Debian's libtbb is not instrumented, so TSan would report oneTBB's own hand-offs as races, and
@@ -55,6 +56,10 @@ ctest --test-dir "$build" --output-on-failure -j "$jobs"
 # The trainer left running drill after drill for 90 s under Xvfb (issue 18): fails the run if its
 # memory grows more than 5 % after the first round of drills or a drill leaks GL objects.
 "$build/perf/phaco-perf" soak --quick --out-dir "$build/perf-quick"
+# The Debian package (issue 23), made from this build tree, then checked as a trainee's PC gets it:
+# lintian, the desktop entry, and the unpacked programs run from an empty folder, finding their
+# data in the package and never opening the source tree (scripts/check-package.sh).
+"$root/scripts/check-package.sh" "$(PHACO_BUILD_DIR="$build" "$root/scripts/package.sh")"
 
 if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   asan="$root/build/asan"

@@ -10,6 +10,7 @@
 #include "apps/phaco/records_commands.hpp"
 #include "apps/phaco/report_command.hpp"
 #include "apps/phaco/sync_command.hpp"
+#include "apps/phaco/version_text.hpp"
 #include "engine/core/error.hpp"
 
 namespace {
@@ -22,10 +23,11 @@ usage:
       Run a scenario headless for its duration at its fixed step; print a summary with the
       drill's metrics and 0-100 score (docs/scoring.md), or, with --json, the JSON report; write
       the JSON report to OUT.json; with --trainee, store the run in the records database
-      (DB, default $PHACO_DB or ~/.local/share/openphaco/records.sqlite; docs/records.md).
+      (DB, default $PHACO_DB, else $XDG_DATA_HOME/openphaco/records.sqlite, by default
+      ~/.local/share/openphaco/records.sqlite; docs/records.md).
       Any DB may be an SQLite file or a postgresql:// URI (a training centre's server).
-      --difficulty picks a level of the drill file (data/drills/<drill>.json, e.g. standard,
-      easy, hard; docs/drills.md) instead of the scenario's.
+      --difficulty picks a level of the drill file (drills/<drill>.json in the data folder,
+      e.g. standard, easy, hard; docs/drills.md) instead of the scenario's.
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
                  [--record DB --trainee NAME]
@@ -79,8 +81,11 @@ usage:
   phaco --help | --version
 
 exit codes: 0 success, 2 bad input (message on stderr), 1 internal error.
-environment: PHACO_DATA_DIR (default: the source tree's data/), PHACO_CACHE_DIR (mesh cache,
-  default ~/.cache/openphaco/meshes).
+  --version prints the version, the source revision and the data folder in use.
+
+environment: PHACO_DATA_DIR (the data: eye/, drills/, scenarios/; default ../share/openphaco
+  beside the executable, e.g. /usr/share/openphaco; docs/install.md), PHACO_CACHE_DIR (mesh
+  cache, default $XDG_CACHE_HOME/openphaco/meshes or ~/.cache/openphaco/meshes), PHACO_DB.
 )";
 
 }  // namespace
@@ -99,7 +104,7 @@ int main(int argc, char** argv) {
       return phaco::cli::kOk;
     }
     if (command == "--version") {
-      std::puts("phaco 0.1.0");
+      std::fputs(phaco::cli::version_text("phaco").c_str(), stdout);
       return phaco::cli::kOk;
     }
     for (const auto& a : args) {

@@ -5,8 +5,10 @@
 #include <string>
 #include <vector>
 
+#include "apps/phaco/version_text.hpp"
 #include "apps/trainer/trainer_app.hpp"
 #include "apps/trainer/trainer_options.hpp"
+#include "apps/trainer/trainer_settings.hpp"
 #include "engine/core/error.hpp"
 #include "engine/render/renderer.hpp"
 
@@ -17,9 +19,16 @@ int main(int argc, char** argv) {
       std::fputs(phaco::trainer::kUsage, stdout);
       return 0;
     }
+    if (a == "--version") {
+      std::fputs(phaco::cli::version_text("phaco-trainer").c_str(), stdout);
+      return 0;
+    }
   }
   try {
-    return phaco::trainer::run_trainer(phaco::trainer::parse_options(args));
+    phaco::trainer::TrainerOptions options = phaco::trainer::parse_options(args);
+    // The last trainee, devices and drill, for what the command line does not say.
+    if (phaco::trainer::interactive(options)) phaco::trainer::recall_settings(options, args);
+    return phaco::trainer::run_trainer(options);
   } catch (const phaco::InputError& e) {
     std::fprintf(stderr, "phaco-trainer: %s\n", e.what());
     return 2;

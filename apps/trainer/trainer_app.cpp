@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/trainer/trainer_settings.hpp"
 #include "apps/trainer/trainer_soak.hpp"
 #include "apps/trainer/trainer_ui.hpp"
 #include "engine/core/clock.hpp"
@@ -404,6 +405,8 @@ int run_trainer(const TrainerOptions& o) {
       }
     }
   }
+  remember_settings(o,
+                    config);  // an interactive run's choices, for the next (trainer_settings.hpp)
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

@@ -24,7 +24,7 @@ usage:
   phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
   phaco-trainer ... --soak OUT.json [--soak-for SECONDS]
   phaco-trainer ... --ui-state OUT.json
-  phaco-trainer --help
+  phaco-trainer --help | --version
 
   --drill       corneal_incision | capsulorhexis | phaco_sculpting | nucleus_removal (default
                 capsulorhexis); the tools start where the drill's expert scenario starts them
@@ -37,7 +37,8 @@ usage:
                 plays a script, else 900)
   --trainee     store each finished drill in the records database (phaco history NAME)
   --db          the records database: this station's SQLite file (default
-                ~/.local/share/openphaco/records.sqlite or $PHACO_DB) or a postgresql:// URI
+                $PHACO_DB, else $XDG_DATA_HOME/openphaco/records.sqlite, by default
+                ~/.local/share/openphaco/records.sqlite) or a postgresql:// URI
   --sync-to     a training centre's PostgreSQL server (postgresql://USER@HOST/DB, or
                 $PHACO_SYNC_TO): drills are stored on this station first, then uploaded in the
                 background; while the centre is unreachable it retries every 30 s (docs/records.md)
@@ -59,6 +60,11 @@ pointer alone), wheel = depth (0.1 mm a click), left button = grip / ultrasound,
 aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers = grip/pedal,
 bumpers = deeper); Space pauses; R restarts; G toggles the guidance cues; F1 shows the controls;
 Esc quits. The label by each tip is its height above the tissue under it.
+An interactive run remembers the trainee, devices, drill and level it ended with in
+$XDG_CONFIG_HOME/openphaco/trainer.json (default ~/.config/openphaco) and starts with them when the
+command line does not say otherwise.
+Data (eye, drills, scenarios): $PHACO_DATA_DIR, else ../share/openphaco beside the program
+(docs/install.md); --version prints the version, the source revision and the data folder in use.
 Exit codes: 0 done, 2 bad input (named), 3 no display or OpenGL 3.3, or an unattended run timed out.
 )";
 

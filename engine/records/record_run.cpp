@@ -8,6 +8,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/core/utc_time.hpp"
+#include "engine/io/user_dirs.hpp"
 #include "engine/records/record_location.hpp"
 #include "engine/records/records.hpp"
 
@@ -31,7 +32,9 @@ void make_parent_dir(const fs::path& db) {
   if (is_postgres_uri(db.string()) || !db.has_parent_path()) return;
   std::error_code ec;
   fs::create_directories(db.parent_path(), ec);
-  if (ec) throw InputError("cannot create '" + db.parent_path().string() + "': " + ec.message());
+  if (ec)
+    throw InputError("cannot create '" + db.parent_path().string() + "': " + ec.message() +
+                     "; give --db FILE|URI or set PHACO_DB (or XDG_DATA_HOME) to a writable place");
 }
 
 // How long the run took, wall seconds: it started that long before now.
@@ -50,11 +53,11 @@ double run_seconds(const json& report, std::optional<double> run_s) {
 fs::path default_records_db() {
   for (const char* name : {"PHACO_DB", "PHACO_RECORDS_DB"})
     if (const char* env = std::getenv(name); env && *env) return env;
-  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg)
-    return fs::path(xdg) / "openphaco" / "records.sqlite";
-  if (const char* home = std::getenv("HOME"); home && *home)
-    return fs::path(home) / ".local" / "share" / "openphaco" / "records.sqlite";
-  throw InputError("no records database: give --db FILE|URI or set PHACO_DB");
+  try {
+    return io::user_dir(io::UserDir::Data) / "records.sqlite";
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + "; give --db FILE|URI or set PHACO_DB");
+  }
 }
 
 void check_record_target(const fs::path& db, const std::string& trainee) {

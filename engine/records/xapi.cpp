@@ -71,6 +71,9 @@ json record_to_xapi(const SessionRecord& r, const std::string& home_page) {
          {{ext + "scenario", r.scenario_name},
           {ext + "state_hash", r.state_hash},
           {ext + "settings", r.settings}}}}}};
+  // The build that made the run (the report's "software": name, version, revision), when known.
+  if (r.report.is_object() && r.report.contains("software"))
+    statement["context"]["extensions"][ext + "software"] = r.report["software"];
   if (!r.uuid.empty()) statement["id"] = r.uuid;
   if (finished) statement["timestamp"] = r.finished_utc;
   return statement;

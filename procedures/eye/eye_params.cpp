@@ -1,7 +1,6 @@
 #include "procedures/eye/eye_params.hpp"
 
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -9,10 +8,6 @@
 #include "engine/core/error.hpp"
 #include "engine/io/json_reader.hpp"
 #include "procedures/eye/eye_param_ranges.hpp"
-
-#ifndef PHACO_DATA_DIR
-#error "PHACO_DATA_DIR must be defined by the build (procedures/CMakeLists.txt)"
-#endif
 
 namespace phaco::eye {
 namespace {
@@ -191,13 +186,6 @@ void apply_override(EyeParams& params, const std::string& key, double value) {
     throw InputError(problem);
   }
   it->second = value;
-}
-
-std::filesystem::path data_dir() {
-  if (const char* env = std::getenv("PHACO_DATA_DIR"); env != nullptr && *env != '\0') {
-    return std::filesystem::path(env);
-  }
-  return std::filesystem::path(PHACO_DATA_DIR);
 }
 
 }  // namespace phaco::eye

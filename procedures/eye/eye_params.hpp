@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "procedures/eye/data_dir.hpp"
+
 namespace phaco::eye {
 
 struct EyeParams {
@@ -33,8 +35,5 @@ EyeParams default_eye_params();
 // or one that is not finite and positive. Geometric consistency (e.g. capsule radius inside the
 // lens) is checked when meshes are made.
 void apply_override(EyeParams& params, const std::string& key, double value);
-
-// The data directory: env PHACO_DATA_DIR if set, else the source tree's data/ (compile time).
-std::filesystem::path data_dir();
 
 }  // namespace phaco::eye

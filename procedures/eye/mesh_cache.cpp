@@ -13,6 +13,7 @@
 #include "engine/io/mesh_obj.hpp"
 #include "engine/io/tetgen_files.hpp"
 #include "engine/io/text_lines.hpp"
+#include "engine/io/user_dirs.hpp"
 
 namespace phaco::eye {
 namespace fs = std::filesystem;
@@ -92,6 +93,8 @@ EyeMeshes MeshCache::load_or_build(const EyeParams& params, const Resolution& re
   ++builds_;
 
   const std::string key = entry.filename().string();
+  io::writable_dir(dir_, "the mesh cache",
+                   "set PHACO_CACHE_DIR or XDG_CACHE_HOME to a writable folder");
   const fs::path tmp = dir_ / (key + ".tmp-" + unique_suffix());
   fs::create_directories(tmp, ec);
   if (ec) {
@@ -124,13 +127,11 @@ EyeMeshes MeshCache::load_or_build(const EyeParams& params, const Resolution& re
 
 fs::path MeshCache::default_dir() {
   if (const char* env = std::getenv("PHACO_CACHE_DIR"); env != nullptr && *env != '\0') return env;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') {
-    return fs::path(xdg) / "openphaco" / "meshes";
+  try {
+    return io::user_dir(io::UserDir::Cache) / "meshes";
+  } catch (const InputError&) {
+    return fs::temp_directory_path() / "openphaco" / "meshes";  // no $HOME: a cache still helps
   }
-  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
-    return fs::path(home) / ".cache" / "openphaco" / "meshes";
-  }
-  return fs::temp_directory_path() / "openphaco" / "meshes";
 }
 
 void write_eye_meshes(const EyeMeshes& meshes, const fs::path& dir) {

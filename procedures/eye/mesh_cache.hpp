@@ -33,7 +33,8 @@ class MeshCache {
   // How many times this cache generated meshes instead of loading them.
   size_t builds() const { return builds_; }
 
-  // env PHACO_CACHE_DIR, else $XDG_CACHE_HOME/openphaco/meshes, else ~/.cache/openphaco/meshes.
+  // env PHACO_CACHE_DIR, else $XDG_CACHE_HOME/openphaco/meshes, else ~/.cache/openphaco/meshes
+  // (engine/io/user_dirs.hpp); without $HOME, the temporary folder's openphaco/meshes.
   static std::filesystem::path default_dir();
 
  private:

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "engine/core/error.hpp"
+#include "engine/core/version.hpp"
 #include "engine/plot/chart.hpp"
 #include "procedures/report/report_fields.hpp"
 #include "procedures/report/term_text.hpp"
@@ -571,11 +572,13 @@ std::string html_report(const json& run, const std::string& extra_sections) {
   page += events_section(r);
   page += plots_section(r);
   page += extra_sections;
-  page +=
-      "<footer>" +
-      note(
-          "Made by `phaco report` from the run report; docs/report.md says what each part shows.") +
-      "</footer>\n</body>\n</html>\n";
+  page += "<footer>" +
+          note("Made by `phaco report` " + std::string(version()) + " (revision " + revision() +
+               ") from the run report" +
+               (r.software.empty() ? std::string(" (it does not say which build made the run)")
+                                   : ", a run of " + r.software) +
+               "; docs/report.md says what each part shows.") +
+          "</footer>\n</body>\n</html>\n";
   return page;
 }
 

@@ -99,6 +99,15 @@ Run read_run(const json& j) {
     r.state_hash = v->is_string() ? v->get<std::string>() : v->dump();
   if (const json* v = member(j, "sim_time_s")) r.sim_time_s = number(*v, "sim_time_s");
   if (const json* v = member(j, "frames")) r.frames = number(*v, "frames");
+  if (const json* sw = member(j, "software")) {
+    require_object(*sw, "software");
+    const json* name = member(*sw, "name");
+    const json* version = member(*sw, "version");
+    const json* revision = member(*sw, "revision");
+    r.software = (name ? text(*name, "software.name") : std::string("OpenPhaco")) + " " +
+                 (version ? text(*version, "software.version") : std::string("?")) + " (revision " +
+                 (revision ? text(*revision, "software.revision") : std::string("unknown")) + ")";
+  }
 
   if (const json* m = member(j, "metrics")) {
     require_object(*m, "metrics");

@@ -50,6 +50,7 @@ struct Trench {
 
 struct Run {
   std::string drill, scenario, date, state_hash;
+  std::string software;  // "OpenPhaco 0.1.0 (revision ...)": the build that made the run, if known
   std::optional<double> sim_time_s, frames;
   bool has_metrics = false;
   std::vector<std::pair<std::string, json>> metrics;  // in the file's (sorted) order

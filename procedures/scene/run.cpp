@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "engine/core/clock.hpp"
+#include "engine/core/version.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/drill_metrics.hpp"
@@ -107,6 +108,8 @@ nlohmann::json to_json(const RunReport& r) {
   j["score_terms"] = r.score_terms;
   j["physics"] = r.physics;
   j["state_hash"] = r.state_hash;
+  // The build that made the run: records and xAPI statements carry it inside the report.
+  j["software"] = {{"name", "OpenPhaco"}, {"version", version()}, {"revision", revision()}};
   // A drill that failed (nucleus_removal: a posterior capsule rupture) says so at the top.
   j["failed"] = r.metrics.value("drill_failed", 0.0) > 0;
   return j;

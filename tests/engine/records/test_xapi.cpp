@@ -31,6 +31,8 @@ SessionRecord sample(const std::string& trainee, double score) {
   r.score = score;
   r.state_hash = "0123456789abcdef";
   r.uuid = "0f8e7a52-7d0c-4c55-9f4e-2b1d6c3a9e10";
+  r.report = {
+      {"software", {{"name", "OpenPhaco"}, {"version", "0.1.0"}, {"revision", "d46c276214a3"}}}};
   return r;
 }
 
@@ -53,6 +55,13 @@ TEST(Xapi, AStatementCarriesScoreSuccessDurationAndMetricsWithUnits) {
   EXPECT_EQ(s["context"]["extensions"][std::string(phaco::kXapiExtensionIri) + "state_hash"],
             "0123456789abcdef");
   EXPECT_EQ(s["timestamp"], "2026-11-21T10:01:02.125Z");
+  // The build that made the run (issue 23), from the record's report; none for an older report.
+  const std::string software = std::string(phaco::kXapiExtensionIri) + "software";
+  EXPECT_EQ(s["context"]["extensions"][software]["revision"], "d46c276214a3");
+  EXPECT_EQ(s["context"]["extensions"][software]["version"], "0.1.0");
+  SessionRecord older = sample("c", 50);
+  older.report = json::object();
+  EXPECT_FALSE(phaco::record_to_xapi(older)["context"]["extensions"].contains(software));
   EXPECT_EQ(phaco::record_to_xapi(sample("b", 74.9))["result"]["success"], false);
 
   EXPECT_EQ(phaco::iso8601_duration(3723.5), "PT1H2M3.5S");

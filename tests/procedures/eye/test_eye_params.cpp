@@ -61,6 +61,20 @@ TEST(EyeParams, DataDirFollowsEnvironment) {
   EXPECT_TRUE(std::filesystem::exists(data_dir() / "eye" / "standard_eye.json"));
 }
 
+// Issue 23: without PHACO_DATA_DIR, a test (an executable inside the build tree, with no
+// ../share/openphaco beside it) reads the source tree's data/; tests/apps/test_install.cpp checks
+// a copy outside the build tree does not.
+TEST(EyeParams, AnExecutableInTheBuildTreeReadsTheSourceData) {
+  const char* old = std::getenv("PHACO_DATA_DIR");
+  const std::string saved = old ? old : "";
+  ::unsetenv("PHACO_DATA_DIR");
+  const phaco::eye::DataDir d = phaco::eye::locate_data_dir();
+  if (old) ::setenv("PHACO_DATA_DIR", saved.c_str(), 1);
+  EXPECT_EQ(d.origin, "build tree");
+  EXPECT_EQ(std::filesystem::weakly_canonical(d.dir),
+            std::filesystem::weakly_canonical(std::filesystem::path(PHACO_SOURCE_DIR) / "data"));
+}
+
 // A copy of the standard file with one line edited, and the text the error must contain.
 struct BadFile {
   const char* name;
