@@ -188,6 +188,7 @@ void incision_metrics(Scene& scene, DrillReport& out) {
     return;
   }
   out.metrics["incision.complete"] = w.complete ? 1 : 0;
+  out.metrics["incision.cut_segments"] = cutting_of(scene)->segments;  // the blade cut: attempted
   if (w.outer_cut) {
     out.metrics["incision.width_mm"] = w.width_mm;
     out.metrics["incision.clock_hour"] = w.clock_hour;
