@@ -212,6 +212,12 @@ void run_cohorts(const StudyOptions& options) {
           fmt("%.0f %%", 100 * c.experts_pass) + " | " + fmt("%.0f %%", 100 * c.novices_pass) +
           " |\n";
   }
+  std::string skipped;
+  for (const std::string& d : kDrills)
+    if (std::find(drills.begin(), drills.end(), d) == drills.end())
+      skipped += (skipped.empty() ? "" : ", ") + d;
+  if (!skipped.empty())
+    md += "\nNot run this time (`--drill` chose the others): " + skipped + ".\n";
   md += "\n![cohort scores](results/cohorts.png)\n\n";
   write_section(dir, "cohorts", md);
   progress.finish();
