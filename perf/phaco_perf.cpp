@@ -14,6 +14,7 @@
 //   phaco-perf sweep        issue 9: every drill at every level, thread count and method
 //   phaco-perf soak         issue 18: the trainer drill after drill; memory, GL objects, haptics
 //   phaco-perf nucleus      issue 19: the nucleus_removal expert per level, 1 and 2 threads
+//   phaco-perf cohorts      issue 20: expert and novice cohorts per drill, AUC and cut-off
 //   phaco-perf records      issue 21: 1, 4, 16 stations syncing to one PostgreSQL server at once
 //   alternative,
 //                           with the haptic thread beside it; the targets; the checks CI runs
@@ -120,6 +121,13 @@ studies:
       threads with the haptic thread beside it: cells, fragments and SPH pairs, frame p50/p99/max,
       the lens system's cost, the 2-thread speed-up, state hashes, and the outcome against the
       finest level run.
+  cohorts [--n N] [--drill NAME]...
+      Issue 20 item 4, do the scores separate skill: per drill (default all four), N scripted
+      experts and N scripted novices (default 30, quick 4) replayed with hand tremor (8-12 Hz,
+      RMS transverse 35 / 59 um, axial 13 / 21 um), tempo and offset variations, each run to its
+      end; score distributions, ROC AUC, the contrasting-groups cut-off (Thomsen 2015) and the
+      share of each cohort that passes it. Writes results/cohorts.*. Nucleus removal takes about
+      a minute per run.
   records [--pg ADMIN_URI]
       Issue 21, 1, 4 and 16 stations (processes, 200 records each) syncing to one PostgreSQL
       server at once: records per second, batch latency p50/p99/max, every record at the centre
@@ -194,6 +202,8 @@ int main(int argc, char** argv) {
       perf::run_records(options);
     } else if (cmd == "nucleus") {
       perf::run_nucleus(options);
+    } else if (cmd == "cohorts") {
+      perf::run_cohorts(options);
     } else if (cmd == "all") {
       if (!options.extra.empty())
         throw InputError("all: unknown option '" + options.extra[0] + "'");

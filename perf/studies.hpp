@@ -28,6 +28,7 @@ void run_sweep(const StudyOptions& options);
 void run_soak(const StudyOptions& options);
 void run_records(const StudyOptions& options);
 void run_nucleus(const StudyOptions& options);
+void run_cohorts(const StudyOptions& options);
 
 // A study's own checks failed (e.g. the sweep's accuracy bounds): the figures are still written,
 // and phaco-perf exits 1 naming what failed.

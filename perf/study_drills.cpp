@@ -155,6 +155,11 @@ void run_drills(const StudyOptions& options) {
       key = "width " + f2(metric(j, "trench.width_mm")) + " mm, depth " +
             f2(metric(j, "trench.depth_fraction")) + ", crossing " +
             fmt("%.1f", metric(j, "trench.crossing_angle_deg")) + "°";
+    else if (r.drill == "nucleus_removal")
+      key = "cracks " + fmt("%.0f", metric(j, "cracks", 0)) + ", volume " +
+            f2(metric(j, "volume_removed_fraction")) + ", CDE " +
+            fmt("%.0f", metric(j, "cde_pct_s", 0)) + " %·s, posterior " +
+            fmt("%.2f", metric(j, "posterior_capsule.min_distance_mm", 0)) + " mm";
     else
       key = "width " + f2(metric(j, "incision.width_mm")) + " mm, angle " +
             fmt("%.1f", metric(j, "incision.entry_angle_deg")) + "°, tunnel " +
@@ -162,8 +167,14 @@ void run_drills(const StudyOptions& options) {
             fmt("%.1f", metric(j, "incision.clock_hour")) + " o'clock";
     const double frame_p50 = j["frame"].value("p50_ms", -1.0),
                  frame_p99 = j["frame"].value("p99_ms", -1.0);
-    md += "| " + r.file + " | " + fmt("%.1f", metric(j, "score")) + " | " + missed(j) + " | " +
-          key + " | " + f2(metric(j, "globe.max_rotation_deg")) + " / " +
+    // A complication (docs/scoring.md) fails the drill: said beside the capped score.
+    std::string failed;
+    for (const auto& c : j.value("complications", nlohmann::json::array())) {
+      const std::string name = c.value("name", std::string());
+      failed += ", failed: " + name.substr(0, name.find(':'));
+    }
+    md += "| " + r.file + " | " + fmt("%.1f", metric(j, "score")) + failed + " | " + missed(j) +
+          " | " + key + " | " + f2(metric(j, "globe.max_rotation_deg")) + " / " +
           fmt("%.1f", metric(j, "ports.max_force_mN")) + " | " + f3(frame_p50) + " / " +
           f3(frame_p99) + " | " + us(system_p50_ms(j, "drill_metrics")) + " / " + us(cut) + " / " +
           us(system_p50_ms(j, "tool_ports")) + " |\n";

@@ -40,7 +40,7 @@ class DrillParser {
     }
     r_.expect_object(root, "$",
                      {"drill", "title", "description", "scene", "tools", "targets", "scoring",
-                      "guidance", "difficulty", "ports"});
+                      "guidance", "difficulty", "ports", "attempted_if_any", "complications"});
     DrillFile d;
     d.source = r_.source();
     const json& drill = r_.require(root, "$", "drill", "a drill name");
@@ -60,6 +60,8 @@ class DrillParser {
     targets(r_.require(root, "$", "targets", "an object of metric → {\"min\", \"max\"}"), d);
     scoring(r_.require(root, "$", "scoring", "an array of {\"metric\", \"weight\", \"falloff\"}"),
             d);
+    if (const json* v = JsonReader::find(root, "attempted_if_any")) attempted(*v, d);
+    if (const json* v = JsonReader::find(root, "complications")) complications(*v, d);
     if (const json* v = JsonReader::find(root, "guidance")) d.guidance = guidance(*v);
     difficulty(r_.require(root, "$", "difficulty", "{\"default\", \"levels\"}"), d);
     if (const json* v = JsonReader::find(root, "ports")) {
@@ -193,6 +195,39 @@ class DrillParser {
     }
     if (std::abs(total - kTotalPoints) > kPointsTolerance) {
       r_.fail("scoring", "weights must sum to 100 points, got " + format_number(total));
+    }
+  }
+
+  void attempted(const json& v, DrillFile& d) const {
+    const json& a = r_.array(v, "attempted_if_any", "metric names");
+    if (a.empty()) r_.fail("attempted_if_any", "expected at least one metric name, got none");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string path = path_index("attempted_if_any", i);
+      std::string name = r_.string(a[i], path);
+      if (name.empty()) r_.fail(path, "expected a metric name, got an empty string");
+      d.attempted_if_any.push_back(std::move(name));
+    }
+  }
+
+  void complications(const json& v, DrillFile& d) const {
+    const json& a = r_.array(v, "complications", "{\"metric\", \"name\", \"score_cap\"}");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string path = path_index("complications", i);
+      r_.expect_object(a[i], path, {"metric", "name", "above", "score_cap"});
+      Complication c;
+      c.metric =
+          r_.string(r_.require(a[i], path, "metric", "a metric name"), path_key(path, "metric"));
+      if (c.metric.empty()) r_.fail(path_key(path, "metric"), "expected a metric name, got \"\"");
+      c.name = r_.string(r_.require(a[i], path, "name", "what the trainee is told"),
+                         path_key(path, "name"));
+      if (c.name.empty()) r_.fail(path_key(path, "name"), "expected a name, got \"\"");
+      if (const json* x = JsonReader::find(a[i], "above")) {
+        c.above =
+            r_.number_in(*x, path_key(path, "above"), -kMaxMetricMagnitude, kMaxMetricMagnitude);
+      }
+      c.score_cap = r_.number_in(r_.require(a[i], path, "score_cap", "points in [0, 100]"),
+                                 path_key(path, "score_cap"), 0, kTotalPoints);
+      d.complications.push_back(std::move(c));
     }
   }
 

@@ -37,6 +37,15 @@ struct ScoreTerm {
   bool operator==(const ScoreTerm&) const = default;
 };
 
+// A complication (docs/scoring.md): when `metric` is above `above`, the drill fails, named `name`,
+// and its score is capped at `score_cap`.
+struct Complication {
+  std::string metric, name;
+  double above = 0;
+  double score_cap = 0;
+  bool operator==(const Complication&) const = default;
+};
+
 // Guidance cues (seed 000 Fig. 8), in the eye frame (DESIGN.md §6), mm. Absent: not drawn/scored.
 struct Guidance {
   std::optional<Vec3> grasp_site_mm;     // where the forceps should first close
@@ -72,6 +81,10 @@ struct DrillFile {
   std::vector<ToolKind> left_tools, right_tools;  // what each hand may hold
   std::map<std::string, TargetBand> targets;      // metric name → band
   std::vector<ScoreTerm> scoring;                 // weights sum to 100
+  // The step was attempted when any of these metrics is > 0; a step not attempted scores 0
+  // (docs/scoring.md). Empty: always attempted.
+  std::vector<std::string> attempted_if_any;
+  std::vector<Complication> complications;
   Guidance guidance;
   std::map<std::string, DifficultySettings> difficulty;  // level name → settings
   std::string default_difficulty;                        // a key of `difficulty`

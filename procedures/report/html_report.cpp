@@ -387,6 +387,9 @@ std::string score_section(const Run& r) {
     out += "<div class=\"score none\">no score</div>";
   }
   out += "<div>";
+  for (const std::string& c : r.complications)
+    out += note("FAILED: " + c + " (a complication caps the score, docs/scoring.md).");
+  if (r.not_attempted) out += note("Not attempted: the step was not done, so it scores 0.");
   if (!r.score)
     out += note(
         "This report carries no metrics.score (an older report file, or a run without scoring).");

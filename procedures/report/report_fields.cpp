@@ -114,6 +114,17 @@ Run read_run(const json& j) {
     r.has_metrics = true;
     for (const auto& [k, v] : m->items()) r.metrics.emplace_back(k, v);
     if (const json* s = member(*m, "score")) r.score = number(*s, "metrics.score");
+    if (const json* a = member(*m, "attempted"))
+      r.not_attempted = number(*a, "metrics.attempted") <= 0;
+  }
+  if (const json* c = member(j, "complications")) {
+    if (!c->is_array()) bad("complications", "expected an array of {\"name\", ...}");
+    for (size_t i = 0; i < c->size(); ++i) {
+      const std::string path = "complications[" + std::to_string(i) + "]";
+      require_object((*c)[i], path);
+      if (const json* v = member((*c)[i], "name"))
+        r.complications.push_back(text(*v, join(path, "name")));
+    }
   }
   if (const json* t = member(j, "targets")) {
     require_object(*t, "targets");

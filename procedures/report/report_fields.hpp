@@ -55,6 +55,8 @@ struct Run {
   bool has_metrics = false;
   std::vector<std::pair<std::string, json>> metrics;  // in the file's (sorted) order
   std::optional<double> score;
+  bool not_attempted = false;              // metrics.attempted 0: the step scored 0
+  std::vector<std::string> complications;  // the names that failed the drill (score capped)
   bool has_targets = false;
   std::map<std::string, Band> targets;
   bool has_terms = false;

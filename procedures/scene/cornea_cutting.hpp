@@ -12,10 +12,11 @@
 //   per surface, two cut paths grow from the puncture to the section's left and right ends; an end
 //   is fed only while it moves away from the puncture (the cut widens, it never heals).
 //
-// The blade stops cutting when it starts to withdraw (its tip moves back along its axis) or leaves
-// the anterior sphere: waiting path ends are finished (cut::finish_cut), the crack tips kept, the
-// paths ended. One incision per run: a second pass is not cut (the wound tracker still follows it).
-// Only keratomes cut the cornea; the cornea's particles stay anchored (no corneal dynamics).
+// The blade stops cutting when it withdraws (its tip 0.1 mm behind the furthest it reached along
+// its axis: less is hand tremor) or leaves the anterior sphere: waiting path ends are finished
+// (cut::finish_cut), the crack tips kept, the paths ended. One incision per run: a second pass is
+// not cut (the wound tracker still follows it). Only keratomes cut the cornea; the cornea's
+// particles stay anchored (no corneal dynamics).
 //
 // Measured at the end (incision_metrics), on the mesh (cut_measure): width = the outer cut's chord;
 // clock hour and limbus distance of the outer cut's middle; tunnel length = |inner middle − outer
@@ -58,7 +59,7 @@ struct CorneaCutting {
   bool cutting = false;  // the blade has punctured the anterior surface and still advances
   bool done = false;     // the paths have ended (the blade withdrew or left the cornea)
   bool have_last_tip = false;
-  Vec3 last_tip = Vec3::Zero();
+  Vec3 last_tip = Vec3::Zero();  // while cutting: the furthest along the blade; before: the last
   cut::EditLog log;
   cut::TriangleGrid grid;  // the uncut cornea's triangles by place: the puncture's start, no scan
   uint64_t frames = 0, cutting_frames = 0, segments = 0;

@@ -267,14 +267,23 @@ double depth_fraction(const lens::NucleusShape& n, const Anatomy& a, const Vec3&
   return top > bottom ? (top - c.z()) / (top - bottom) : 0.0;
 }
 
-// The drill file's score terms (docs/scoring.md) against the targets in `out`.
-void score(DrillReport& out, std::span<const ScoreTerm> terms) {
-  for (const ScoreTerm& t : terms) {
+// The drill file's score terms (docs/scoring.md) against the targets in `out`. A step not
+// attempted scores 0 (its safety terms included: "no contact" is no skill when nothing was done);
+// a complication fails the drill and caps its score.
+void score(DrillReport& out, const DrillFile& drill) {
+  const auto number = [&out](const std::string& metric) {
+    return out.metrics.contains(metric) && out.metrics[metric].is_number()
+               ? std::optional<double>(out.metrics[metric].get<double>())
+               : std::nullopt;
+  };
+  out.attempted = drill.attempted_if_any.empty();
+  for (const std::string& m : drill.attempted_if_any) out.attempted |= number(m).value_or(0.0) > 0;
+  for (const ScoreTerm& t : drill.scoring) {
     const nlohmann::json value =
         out.metrics.contains(t.metric) ? out.metrics[t.metric] : nlohmann::json();
     const nlohmann::json target =
         out.targets.contains(t.metric) ? out.targets[t.metric] : nlohmann::json::object();
-    const double points = band_points(value, target, t.falloff, t.weight);
+    const double points = out.attempted ? band_points(value, target, t.falloff, t.weight) : 0.0;
     out.score_terms.push_back({{"metric", t.metric},
                                {"value", value},
                                {"target", target},
@@ -283,6 +292,15 @@ void score(DrillReport& out, std::span<const ScoreTerm> terms) {
     out.score += points;
   }
   out.score = std::clamp(out.score, 0.0, 100.0);
+  for (const Complication& c : drill.complications) {
+    const auto v = number(c.metric);
+    if (!v || *v <= c.above) continue;
+    out.complications.push_back(
+        {{"name", c.name}, {"metric", c.metric}, {"value", *v}, {"score_cap", c.score_cap}});
+    out.score = std::min(out.score, c.score_cap);
+  }
+  out.metrics["attempted"] = out.attempted ? 1 : 0;
+  out.metrics["drill_failed"] = out.complications.empty() ? 0 : 1;
 }
 
 void hand_metrics(const Scene& scene, const DrillRecord& r, DrillReport& out,
@@ -334,10 +352,10 @@ void hand_metrics(const Scene& scene, const DrillRecord& r, DrillReport& out,
 }
 
 void capsulorhexis_metrics(Scene& scene, const DrillRecord& r, DrillReport& out) {
-  uint64_t grasps = 0, lens = 0;
-  for (const HandRecord& h : r.hands) grasps += h.grasps, lens += h.lens_contacts;
+  uint64_t grasps = 0;
+  for (const HandRecord& h : r.hands) grasps += h.grasps;
+  out.metrics["grasps"] = grasps;
   out.metrics["regrasps"] = grasps > 0 ? grasps - 1 : 0;  // the first grasp is not a regrasp
-  out.metrics["lens_contacts"] = lens;
   if (r.puncture && scene.drill.guidance.puncture_site_mm) {
     out.metrics["rhexis.puncture_offset_mm"] =
         (*r.puncture - *scene.drill.guidance.puncture_site_mm).norm();
@@ -355,6 +373,7 @@ void capsulorhexis_metrics(Scene& scene, const DrillRecord& r, DrillReport& out)
     tearouts += std::string_view(e.kind) == "radial_tearout";
     warnings += std::string_view(e.kind) == "runout_warning";
   }
+  out.metrics["capsule.cut_segments"] = cc->cut_segments;
   out.metrics["rhexis.radial_tearouts"] = tearouts;
   out.metrics["runout_warnings"] = warnings;
   CapsuleSprings& cp = scene.world.at<CapsuleSprings>(*capsule);
@@ -504,9 +523,10 @@ DrillReport drill_report(Scene& scene) {
   const DrillRecord* r = record_of(scene);
   if (!r) return out;
   out.metrics["time_s"] = scene.time_s;
-  uint64_t stress = 0;
-  for (const HandRecord& h : r->hands) stress += h.corneal_stress;
+  uint64_t stress = 0, lens = 0;
+  for (const HandRecord& h : r->hands) stress += h.corneal_stress, lens += h.lens_contacts;
   out.metrics["corneal_stress_events"] = stress;
+  out.metrics["lens_contacts"] = lens;  // a tip entering the lens (every drill: an attempt)
   // Targets are the drill file's (data/drills); the per-trench ones derive from them.
   for (const auto& [name, b] : scene.drill.targets) out.targets[name] = band(b.min, b.max);
   if (r->first_grasp && scene.drill.guidance.grasp_site_mm) {
@@ -540,7 +560,7 @@ DrillReport drill_report(Scene& scene) {
     }
   }
   ports_metrics(scene, out.metrics);  // globe rotation, port force (ports on only)
-  score(out, scene.drill.scoring);
+  score(out, scene.drill);
   out.metrics["score"] = out.score;
 
   for (const DrillEvent& e : r->events) {

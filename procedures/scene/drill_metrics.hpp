@@ -47,7 +47,10 @@ struct DrillReport {
   nlohmann::json series = nlohmann::json::object();   // t_s, hands, rhexis, trench
   nlohmann::json score_terms =
       nlohmann::json::array();  // {"metric", "value", "target", "weight", "points"}
-  double score = 0;             // 0..100, = Σ points
+  double score = 0;             // 0..100: Σ points, 0 if not attempted, capped by a complication
+  bool attempted = true;        // the drill file's attempted_if_any (docs/scoring.md)
+  nlohmann::json complications =
+      nlohmann::json::array();  // {"name", "metric", "value", "score_cap"}: the drill failed
 };
 
 // The drill's report so far (call at the end of the run); empty if the scene has no record.

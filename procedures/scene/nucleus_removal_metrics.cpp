@@ -118,7 +118,6 @@ void nucleus_removal_metrics(Scene& scene, const NucleusRemovalRecord& r, nlohma
     m["endothelium.min_distance_mm"] = r.endothelium_min_distance_mm;
   m["endothelium.time_within_1mm_s"] = r.endothelium_near_s;
   m["anterior_chamber_fragments.max"] = r.anterior_chamber_max;
-  m["drill_failed"] = r.ruptured ? 1 : 0;
 }
 
 }  // namespace phaco

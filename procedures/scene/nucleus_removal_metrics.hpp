@@ -16,8 +16,9 @@
 //                      centre of mass is out of the bag through the rhexis (above the anterior
 //                      capsule's sphere): the most at once.
 // At the end: time, fragments removed, volume removed (and its fraction of the grooved lens), CDE,
-// aspiration time, the chopper's force (max, mean over the frames it pushed), the above, and
-// drill_failed (1 after a rupture). Reads the lens's LensFragments and the tools' poses.
+// aspiration time, the chopper's force (max, mean over the frames it pushed) and the above
+// (posterior_capsule.rupture is the drill file's complication: drill_failed). Reads the lens's
+// LensFragments and the tools' poses.
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>

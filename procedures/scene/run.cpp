@@ -72,6 +72,7 @@ RunReport report_of(Scene& scene) {
   r.events = std::move(drill.events);
   r.series = std::move(drill.series);
   r.score_terms = std::move(drill.score_terms);
+  r.complications = std::move(drill.complications);
   r.peak_memory_mb = peak_memory_mb();
   return r;
 }
@@ -110,8 +111,10 @@ nlohmann::json to_json(const RunReport& r) {
   j["state_hash"] = r.state_hash;
   // The build that made the run: records and xAPI statements carry it inside the report.
   j["software"] = {{"name", "OpenPhaco"}, {"version", version()}, {"revision", revision()}};
-  // A drill that failed (nucleus_removal: a posterior capsule rupture) says so at the top.
-  j["failed"] = r.metrics.value("drill_failed", 0.0) > 0;
+  // A drill that failed (a complication: docs/scoring.md) says so, and why, at the top.
+  j["failed"] = !r.complications.empty();
+  j["complications"] = r.complications;
+  j["attempted"] = r.metrics.value("attempted", 1.0) > 0;
   return j;
 }
 
@@ -200,7 +203,12 @@ std::string summary_text(const RunReport& r) {
   if (r.metrics.contains("score")) {
     std::snprintf(line, sizeof line, "\nscore %.1f / 100", r.metrics["score"].get<double>());
     out += line;
-    if (r.metrics.value("drill_failed", 0.0) > 0) out += "   FAILED (posterior capsule rupture)";
+    if (r.metrics.value("attempted", 1.0) <= 0) out += "   NOT ATTEMPTED (scores 0)";
+    for (const auto& c : r.complications) {
+      std::snprintf(line, sizeof line, "   FAILED (%s: score capped at %.0f)",
+                    c.value("name", std::string()).c_str(), c.value("score_cap", 0.0));
+      out += line;
+    }
     for (const auto& t : r.score_terms) {
       const std::string value = t["value"].is_number() ? t["value"].dump() : std::string("-");
       std::snprintf(line, sizeof line, "\n  %-28s %-12s %5.1f / %4.1f",

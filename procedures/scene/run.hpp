@@ -37,6 +37,9 @@ struct RunReport {
   nlohmann::json series = nlohmann::json::object();  // t_s, hands, rhexis, trench (≤ 2000 samples)
   // The score's breakdown: {"metric", "value", "target", "weight", "points"} per term.
   nlohmann::json score_terms = nlohmann::json::array();
+  // The complications that failed the drill and capped its score: {"name", "metric", "value",
+  // "score_cap"} (docs/scoring.md); metrics.attempted 0 says the step was not attempted (score 0).
+  nlohmann::json complications = nlohmann::json::array();
   // Per deformable body: method, steps, divergences, active set.
   nlohmann::json physics = nlohmann::json::object();
   std::string state_hash;

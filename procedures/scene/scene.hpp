@@ -4,7 +4,7 @@
 //
 // Which bodies a drill loads is its drill file's "scene.bodies" (data/drills; model no more than
 // the scene needs, DESIGN.md §3):
-//   corneal_incision: cornea, iris, globe              (no lens at all)
+//   corneal_incision: cornea, iris, globe, lens_surface (drawn: the red reflex; no lens physics)
 //   capsulorhexis:    cornea, capsule, iris, lens_surface
 //   phaco_sculpting:  cornea, capsule, iris, lens (tetrahedra)
 //   nucleus_removal:  cornea, capsule, iris, lens (simplex cells, grooved; lens_fragments.hpp)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "procedures/scene/port_pivot.hpp"
+
 namespace phaco {
 
 namespace {
@@ -93,7 +95,8 @@ DesktopInput::DesktopInput(const DesktopMapping& mapping) : mapping_(mapping) {
 
 void DesktopInput::publish(Hand hand) {
   Slot& s = slots_[at(hand)];
-  const ToolPose& p = pose_[at(hand)];
+  const auto& port = port_[at(hand)];
+  const ToolPose p = port ? pivot_in_port(pose_[at(hand)], *port) : pose_[at(hand)];
   const uint64_t seq = s.seq.load(std::memory_order_relaxed);
   s.seq.store(seq + 1, std::memory_order_relaxed);  // odd: a write in progress
   // Release fence: a reader that sees any field below also sees the odd sequence first.
@@ -129,6 +132,11 @@ uint64_t DesktopInput::read_pose(Hand hand, ToolPose& out) const {
 void DesktopInput::set_start(Hand hand, ToolKind tool, const ToolPose& pose) {
   tool_[at(hand)] = tool;
   set_hand_pose(hand, pose);
+}
+
+void DesktopInput::set_port(Hand hand, const std::optional<EyePort>& port) {
+  port_[at(hand)] = port;
+  publish(hand);
 }
 
 void DesktopInput::set_hand_pose(Hand hand, const ToolPose& pose) {

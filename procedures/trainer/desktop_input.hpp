@@ -18,7 +18,9 @@
 //              at depth_speed_mm_s; the triggers (LT/RT) grip the forceps 0..1 or set the probe's
 //              pedal 0..3 in proportion.
 // Tips stay in a box about the eye (workspace_*); the shaft keeps the scenario's first pose's
-// orientation. Every pose starts at the scenario's first track pose (set_start_pose).
+// orientation, or, for a hand given a port (set_port: the trainer's default when the drill has
+// ports), pivots in it once the tip is in the eye (procedures/scene/port_pivot). Every pose starts
+// at the scenario's first track pose (set_start_pose).
 //
 // Thread safety: one writer thread (the UI) for all the mutators, any number of readers
 // (read_pose). A seqlock per hand: the writer bumps the sequence to odd, writes the fields
@@ -28,7 +30,9 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
+#include "components/eye_ports.hpp"
 #include "engine/haptics/device.hpp"
 #include "engine/io/scenario.hpp"
 #include "engine/io/track.hpp"
@@ -73,10 +77,12 @@ class DesktopInput {
   // scenario's first track pose; the trainer session does this).
   void set_start(Hand hand, ToolKind tool, const ToolPose& pose);
   void set_hand_pose(Hand hand, const ToolPose& pose);  // absolute (clamped to the workspace)
-  void mouse_move(double dx_px, double dy_px);          // the selected hand
-  void wheel(double clicks);                            // the selected hand; + = deeper
-  void mouse_buttons(bool left, bool right);            // the selected hand
-  void switch_hand();                                   // the other hand becomes selected
+  // The port `hand`'s shaft pivots in (nullopt: none, the shaft keeps its orientation).
+  void set_port(Hand hand, const std::optional<EyePort>& port);
+  void mouse_move(double dx_px, double dy_px);  // the selected hand
+  void wheel(double clicks);                    // the selected hand; + = deeper
+  void mouse_buttons(bool left, bool right);    // the selected hand
+  void switch_hand();                           // the other hand becomes selected
   void select(Hand hand);
   void gamepad(const GamepadState& pad, double dt_s);  // both hands
 
@@ -99,6 +105,7 @@ class DesktopInput {
   // Writer thread only.
   std::array<ToolPose, 2> pose_{};
   std::array<ToolKind, 2> tool_{ToolKind::Forceps, ToolKind::Forceps};
+  std::array<std::optional<EyePort>, 2> port_;
   std::array<Slot, 2> slots_;
   std::atomic<uint8_t> selected_{static_cast<uint8_t>(Hand::Right)};
 };

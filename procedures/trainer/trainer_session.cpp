@@ -13,6 +13,7 @@
 #include "engine/records/record_run.hpp"
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/run.hpp"
+#include "procedures/trainer/live_ports.hpp"
 #include "procedures/trainer/snapshot_fill.hpp"
 
 namespace phaco {
@@ -59,8 +60,10 @@ void TrainerSession::launch(const Scenario& scenario, const std::array<std::stri
   stop();
   launched_scenario_ = scenario;
   launched_devices_ = devices;
-  running_scenario_ = scenario;
+  // Live inputs hold their tools in the ports (procedures/trainer/live_ports.hpp).
+  running_scenario_ = with_live_ports(scenario, devices);
   running_devices_ = devices;
+  const auto pivots = desktop_ports(running_scenario_);
   if (!config_.trainee.empty()) {
     // Fail before the drill, not after it: the database opens and the name is acceptable.
     check_record_target(config_.records_db.empty() ? default_records_db() : config_.records_db,
@@ -77,6 +80,7 @@ void TrainerSession::launch(const Scenario& scenario, const std::array<std::stri
     if (!track || is_trackless(spec)) continue;
     std::unique_ptr<Device> device;
     if (spec == "desktop") {
+      desktop_->set_port(h, pivots[at(h)]);
       desktop_->set_start(h, track->tool, sample_track(track->track, 0.0));
       device = std::make_unique<DesktopDevice>(desktop_, h);
     } else {

@@ -109,8 +109,7 @@ bool iris_brown(const cv::Vec3b& p) {
   return p[2] > 60 && p[2] > p[1] && p[1] > p[0] && p[2] - p[0] > 40;
 }
 
-// The eye is in frame: its iris ring shows around the centre, and the centre is drawn (the pupil
-// is black only where no lens is behind it: the incision scene has none).
+// The eye is in frame: its iris ring shows around the centre, and the centre is drawn.
 void expect_eye_in_frame(const cv::Mat& img) {
   const render::Microscope m;
   const auto c = render::project_to_pixel(m, Vec3(0, 0, 1.8), kWidth, kHeight);
@@ -118,7 +117,7 @@ void expect_eye_in_frame(const cv::Mat& img) {
   EXPECT_NEAR(c[1], kHeight / 2.0, kHeight / 8.0);
   const cv::Rect eye(static_cast<int>(c[0]) - 300, static_cast<int>(c[1]) - 300, 600, 600);
   EXPECT_GT(count(img, eye, iris_brown), 20000) << "the iris ring";
-  // Inside the limbus nothing is background but the incision scene's lensless pupil.
+  // Inside the limbus nothing is background.
   const double limbus =
       std::abs(render::project_to_pixel(m, Vec3(5.5, 0, 1.2), kWidth, kHeight)[0] - c[0]);
   const double pupil =
@@ -199,6 +198,14 @@ TEST_F(TrainerCli, IncisionShowsTheScleraAndTheKeratome) {
   expect_eye_in_frame(img);
   expect_tools_at_their_tips(img, "corneal_incision_expert.json", t_s);
   EXPECT_GT(count(img, cv::Rect(0, 0, kWidth, kHeight), sclera), kWidth * kHeight / 8);
+  // The lens is behind the pupil (issue 20 item 5): the red reflex fills its centre, 2 mm about
+  // the axis, where the keratome (at 3 o'clock, by the limbus) is not; without it the disc is
+  // black.
+  const render::Microscope m;
+  const auto c = render::project_to_pixel(m, Vec3(0, 0, 1.8), kWidth, kHeight);
+  const double r =
+      std::abs(render::project_to_pixel(m, Vec3(2.0, 0, 1.8), kWidth, kHeight)[0] - c[0]);
+  EXPECT_GT(count_in_disc(img, c[0], c[1], r, reflex_red), M_PI * r * r / 2) << "the red reflex";
 }
 
 // With its panels on, a drill that reaches its end is finished by the UI: scored and stored for the

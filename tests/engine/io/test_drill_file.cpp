@@ -59,6 +59,8 @@ TEST(DrillFile, TheShippedDrillsLoadAndNameTheirDrills) {
     EXPECT_TRUE(d.difficulty.count("hard")) << name;
     EXPECT_EQ(d.difficulty.at("standard"), DifficultySettings{})
         << name << ": the standard level is the eye file's patient as is";
+    EXPECT_FALSE(d.attempted_if_any.empty()) << name << ": idle tools must score 0";
+    EXPECT_FALSE(d.complications.empty()) << name;
   }
   const DrillFile rhexis = load_drill_file(kDrillDir / "capsulorhexis.json");
   ASSERT_TRUE(rhexis.guidance.rhexis_circle);
@@ -79,6 +81,18 @@ TEST(DrillFile, ParsesEveryPart) {
   EXPECT_FALSE(d.guidance.grasp_site_mm);
   EXPECT_EQ(d.default_difficulty, "standard");
   EXPECT_DOUBLE_EQ(*d.difficulty.at("hard").patient_age_years, 85);
+  EXPECT_TRUE(d.attempted_if_any.empty()) << "optional: no list, always attempted";
+  EXPECT_TRUE(d.complications.empty());
+  json j = valid_drill();
+  j["attempted_if_any"] = {"grasps", "lens_contacts"};
+  j["complications"] = {
+      {{"metric", "rhexis.radial_tearouts"}, {"name", "tear-out"}, {"score_cap", 40}},
+      {{"metric", "lens_contacts"}, {"name", "lens hit"}, {"above", 2}, {"score_cap", 30}}};
+  const DrillFile c = parse(j);
+  EXPECT_EQ(c.attempted_if_any, (std::vector<std::string>{"grasps", "lens_contacts"}));
+  ASSERT_EQ(c.complications.size(), 2u);
+  EXPECT_EQ(c.complications[0], (Complication{"rhexis.radial_tearouts", "tear-out", 0, 40}));
+  EXPECT_EQ(c.complications[1], (Complication{"lens_contacts", "lens hit", 2, 30}));
 }
 
 TEST(DrillFile, MalformedFilesNameTheField) {
@@ -127,6 +141,28 @@ TEST(DrillFile, MalformedFilesNameTheField) {
        "difficulty.levels.hard.patient_age_years"},
       {"unknown setting", [](json& j) { j["difficulty"]["levels"]["hard"]["myopia_d"] = 3; },
        "difficulty.levels.hard.myopia_d: unknown difficulty setting"},
+      {"attempt list empty", [](json& j) { j["attempted_if_any"] = json::array(); },
+       "attempted_if_any: expected at least one metric name"},
+      {"attempt not a name",
+       [](json& j) {
+         j["attempted_if_any"] = {"grasps", 3};
+       },
+       "attempted_if_any[1]"},
+      {"complication without cap",
+       [](json& j) {
+         j["complications"] = {{{"metric", "lens_contacts"}, {"name", "n"}}};
+       },
+       "complications[0].score_cap: missing required field"},
+      {"complication cap above 100",
+       [](json& j) {
+         j["complications"] = {{{"metric", "lens_contacts"}, {"name", "n"}, {"score_cap", 101}}};
+       },
+       "complications[0].score_cap"},
+      {"complication unnamed",
+       [](json& j) {
+         j["complications"] = {{{"metric", "lens_contacts"}, {"name", ""}, {"score_cap", 40}}};
+       },
+       "complications[0].name"},
   };
   for (const Case& c : cases) {
     json j = valid_drill();

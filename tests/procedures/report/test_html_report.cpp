@@ -196,6 +196,18 @@ TEST(HtmlReport, MissingSectionsAreLeftOutWithANote) {
   EXPECT_EQ(page.find("class=\"met\""), std::string::npos);
 }
 
+// Issue 20 item 3: a complication and a step not attempted are said under the score.
+TEST(HtmlReport, AFailedOrUnattemptedDrillSaysSo) {
+  json run = fixture();
+  EXPECT_EQ(html_report(run).find("FAILED"), std::string::npos);
+  run["complications"] = {{{"name", "posterior capsule rupture"}, {"score_cap", 40}}};
+  EXPECT_NE(html_report(run).find("FAILED: posterior capsule rupture"), std::string::npos);
+  run["metrics"]["attempted"] = 0;
+  EXPECT_NE(html_report(run).find("Not attempted"), std::string::npos);
+  run["complications"] = 3;
+  EXPECT_NE(expect_input_error(run).find("complications"), std::string::npos);
+}
+
 TEST(HtmlReport, SeriesOfUnequalLengthAreCutToTheShorterWithANote) {
   json run = fixture();
   auto& force = run["series"]["hands"]["left"]["force_mN"];

@@ -67,7 +67,10 @@ void expect_common_contract(const DemoRun& run) {
   EXPECT_GE(r.score, 0.0);
   EXPECT_LE(r.score, 100.0);
   EXPECT_DOUBLE_EQ(r.metrics["score"].get<double>(), r.score);
-  // The score is the sum of its terms, each within 0..weight; the weights add to 100.
+  // The score is the sum of its terms, each within 0..weight; the weights add to 100 (no demo has
+  // a complication, which would cap the sum, nor is idle).
+  EXPECT_TRUE(r.complications.empty());
+  EXPECT_TRUE(r.attempted);
   double sum = 0, weights = 0;
   for (const auto& t : r.score_terms) {
     EXPECT_GE(t["points"].get<double>(), 0.0);
