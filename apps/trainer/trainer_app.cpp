@@ -162,13 +162,110 @@ void write_stats(const std::filesystem::path& file, const TrainerOptions& o, con
   if (!out) throw InputError(file.string() + ": cannot write the statistics");
 }
 
-}  // namespace
+// A soak run's sample of the drill that just ended (its report r): memory, GL objects, the
+// haptic period, the render frames since the drill began (frame0) and its score.
+SoakSample soak_sample(const nlohmann::json& r, const std::string& drill, size_t index,
+                       double wall_s, const FrameClock& frames, size_t frame0) {
+  SoakSample s;
+  s.drill_index = static_cast<int>(index);
+  s.drill = drill;
+  s.wall_s = wall_s;
+  s.rss_mb = resident_mb();
+  count_gl_objects(s);
+  const nlohmann::json period = r.contains("live")
+                                    ? r["live"]["haptics"].value("period", nlohmann::json())
+                                    : nlohmann::json();
+  s.haptic_period_p99_us = period.is_object() ? period.value("p99_us", 0.0) : 0.0;
+  s.haptic_period_max_us = period.is_object() ? period.value("max_us", 0.0) : 0.0;
+  if (r.contains("live"))
+    s.haptic_fifo =
+        r["live"]["haptics"].value("realtime", nlohmann::json::object()).value("fifo", false);
+  FrameClock drill_frames;
+  drill_frames.ms.assign(frames.ms.begin() + static_cast<std::ptrdiff_t>(frame0), frames.ms.end());
+  s.render_frame_p99_ms = drill_frames.percentile(0.99);
+  s.score = r.value("metrics", nlohmann::json::object()).value("score", 0.0);
+  return s;
+}
 
-int run_trainer(const TrainerOptions& o) {
-  TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
-  // So are bad device specs and trainee names (the session checks them without building anything).
-  auto session = std::make_unique<TrainerSession>(config);
-  Glfw glfw;
+// One frame's input into the session's DesktopInput (read by the haptic thread through the hands'
+// devices) and the keys. The clutch: the pointer drives the tool only over the view (inside the
+// window, on no panel).
+void read_input(GLFWwindow* window, InputGlue& glue, const TrainerOptions& o,
+                TrainerSession& session, render::Renderer& renderer, TrainerUi& ui,
+                const FrameClock& frames) {
+  const bool ui_has_mouse = o.ui && ImGui::GetIO().WantCaptureMouse;
+  const bool ui_has_keys = o.ui && ImGui::GetIO().WantCaptureKeyboard;
+
+  DesktopInput& in = session.desktop();
+  double x = 0, y = 0;
+  glfwGetCursorPos(window, &x, &y);
+  int win_w = 0, win_h = 0;
+  glfwGetWindowSize(window, &win_w, &win_h);
+  const bool in_view =
+      x >= 0 && y >= 0 && x < win_w && y < win_h && !ui_has_mouse && !(o.ui && over_panel(x, y));
+  const bool clutch_held = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS ||
+                           glfwGetKey(window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                           glfwGetKey(window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+  const auto [dx, dy] = clutch_step(glue.clutch, x, y, in_view, clutch_held);
+  if (dx != 0 || dy != 0) in.mouse_move(dx, dy);
+  if (glue.wheel != 0 && in_view) in.wheel(glue.wheel);
+  glue.wheel = 0;
+  if (in_view) {
+    in.mouse_buttons(glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS,
+                     glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS);
+  }
+  if (glfwJoystickIsGamepad(GLFW_JOYSTICK_1)) {
+    GLFWgamepadstate g;
+    if (glfwGetGamepadState(GLFW_JOYSTICK_1, &g)) {
+      GamepadState pad;
+      for (int i = 0; i < 6; ++i) pad.axes[static_cast<size_t>(i)] = g.axes[i];
+      for (int i = 0; i < 15; ++i) pad.buttons[static_cast<size_t>(i)] = g.buttons[i] == GLFW_PRESS;
+      in.gamepad(pad, frames.ms.empty() ? 0.0 : frames.ms.back() * 1e-3);
+    }
+  }
+  if (!ui_has_keys) {
+    if (pressed_once(window, GLFW_KEY_TAB, glue.tab_down)) in.switch_hand();
+    if (pressed_once(window, GLFW_KEY_SPACE, glue.space_down)) {
+      session.state() == TrainerState::Paused ? session.resume() : session.pause();
+    }
+    if (pressed_once(window, GLFW_KEY_R, glue.r_down)) session.reset();
+    if (pressed_once(window, GLFW_KEY_G, glue.g_down))
+      renderer.options().guidance = !renderer.options().guidance;
+    if (pressed_once(window, GLFW_KEY_F1, glue.f1_down)) ui.toggle_controls();
+  }
+}
+
+// Closing with drills the database refused: never lose them silently. Beside the database first;
+// where that folder is the problem (read-only, full), the temp folder. False when neither took
+// them.
+bool keep_unsaved(TrainerSession& session, const TrainerConfig& config) {
+  if (session.unsaved_count() == 0) return true;
+  std::vector<std::filesystem::path> dirs;
+  try {
+    const auto db = config.records_db.empty() ? default_records_db() : config.records_db;
+    if (!is_postgres_uri(db.string())) dirs.push_back(db.parent_path() / "unsaved");
+  } catch (const InputError&) {
+  }
+  dirs.push_back(std::filesystem::temp_directory_path() / "openphaco-unsaved");
+  std::string why;
+  bool kept = false;
+  for (const auto& dir : dirs) {
+    try {
+      for (const auto& f : session.write_unsaved(dir))
+        std::fprintf(stderr, "phaco-trainer: an unsaved drill is kept in %s\n", f.c_str());
+      kept = true;
+      break;
+    } catch (const InputError& e) {
+      why += std::string(why.empty() ? "" : "; ") + e.what();
+    }
+  }
+  if (!kept)
+    std::fprintf(stderr, "phaco-trainer: unsaved drills could not be kept: %s\n", why.c_str());
+  return kept;
+}
+
+// The trainer's window with an OpenGL 3.3 core context, its input routed to `glue`.
+GLFWwindow* open_window(const TrainerOptions& o, InputGlue& glue) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -178,19 +275,34 @@ int run_trainer(const TrainerOptions& o) {
   glfwMakeContextCurrent(window);
   // Unattended runs measure and capture as fast as the renderer goes; a trainee gets v-sync.
   glfwSwapInterval(o.screenshot || o.stats || o.soak ? 0 : 1);
-  InputGlue glue;
   glfwSetWindowUserPointer(window, &glue);
   glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) { glue_of(w)->wheel += dy; });
   // A key tapped between two frames (a slow software-rendered frame, or a synthetic key) still
   // reads as pressed once: glfwGetKey keeps the press until it is read.
   glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
+  return window;
+}
 
+// Dear ImGui on the window: no imgui.ini beside the user's files, the panels' font.
+void start_imgui(GLFWwindow* window, const TrainerOptions& o) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
   if (o.ui) load_font();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330");
+}
+
+}  // namespace
+
+int run_trainer(const TrainerOptions& o) {
+  TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
+  // So are bad device specs and trainee names (the session checks them without building anything).
+  auto session = std::make_unique<TrainerSession>(config);
+  Glfw glfw;
+  InputGlue glue;
+  GLFWwindow* window = open_window(o, glue);
+  start_imgui(window, o);
 
   int exit_code = 0;
   {
@@ -227,25 +339,8 @@ int run_trainer(const TrainerOptions& o) {
         // A drill ended: sample, then the next drill in a new session, as a station runs.
         const nlohmann::json r =
             st == TrainerState::Ended ? session->finish() : session->last_report();
-        SoakSample s;
-        s.drill_index = static_cast<int>(soak_samples.size());
-        s.drill = soak_drill;
-        s.wall_s = wall_s();
-        s.rss_mb = resident_mb();
-        count_gl_objects(s);
-        const nlohmann::json period = r.contains("live")
-                                          ? r["live"]["haptics"].value("period", nlohmann::json())
-                                          : nlohmann::json();
-        s.haptic_period_p99_us = period.is_object() ? period.value("p99_us", 0.0) : 0.0;
-        s.haptic_period_max_us = period.is_object() ? period.value("max_us", 0.0) : 0.0;
-        if (r.contains("live"))
-          s.haptic_fifo =
-              r["live"]["haptics"].value("realtime", nlohmann::json::object()).value("fifo", false);
-        FrameClock drill_frames;
-        drill_frames.ms.assign(frames.ms.begin() + static_cast<std::ptrdiff_t>(soak_frame0),
-                               frames.ms.end());
-        s.render_frame_p99_ms = drill_frames.percentile(0.99);
-        s.score = r.value("metrics", nlohmann::json::object()).value("score", 0.0);
+        const SoakSample s =
+            soak_sample(r, soak_drill, soak_samples.size(), wall_s(), frames, soak_frame0);
         soak_samples.push_back(s);
         std::printf("soak: drill %d (%s) done at %.0f s: %.1f MiB, %d buffers, %d textures\n",
                     s.drill_index, s.drill.c_str(), s.wall_s, s.rss_mb, s.gl_buffers,
@@ -267,49 +362,7 @@ int run_trainer(const TrainerOptions& o) {
         continue;
       }
       if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
-      const bool ui_has_mouse = o.ui && ImGui::GetIO().WantCaptureMouse;
-      const bool ui_has_keys = o.ui && ImGui::GetIO().WantCaptureKeyboard;
-
-      // Input → DesktopInput (read by the haptic thread through the hands' devices). The clutch:
-      // the pointer drives the tool only over the view (inside the window, on no panel).
-      DesktopInput& in = session->desktop();
-      double x = 0, y = 0;
-      glfwGetCursorPos(window, &x, &y);
-      int win_w = 0, win_h = 0;
-      glfwGetWindowSize(window, &win_w, &win_h);
-      const bool in_view = x >= 0 && y >= 0 && x < win_w && y < win_h && !ui_has_mouse &&
-                           !(o.ui && over_panel(x, y));
-      const bool clutch_held = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS ||
-                               glfwGetKey(window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
-                               glfwGetKey(window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
-      const auto [dx, dy] = clutch_step(glue.clutch, x, y, in_view, clutch_held);
-      if (dx != 0 || dy != 0) in.mouse_move(dx, dy);
-      if (glue.wheel != 0 && in_view) in.wheel(glue.wheel);
-      glue.wheel = 0;
-      if (in_view) {
-        in.mouse_buttons(glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS,
-                         glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS);
-      }
-      if (glfwJoystickIsGamepad(GLFW_JOYSTICK_1)) {
-        GLFWgamepadstate g;
-        if (glfwGetGamepadState(GLFW_JOYSTICK_1, &g)) {
-          GamepadState pad;
-          for (int i = 0; i < 6; ++i) pad.axes[static_cast<size_t>(i)] = g.axes[i];
-          for (int i = 0; i < 15; ++i)
-            pad.buttons[static_cast<size_t>(i)] = g.buttons[i] == GLFW_PRESS;
-          in.gamepad(pad, frames.ms.empty() ? 0.0 : frames.ms.back() * 1e-3);
-        }
-      }
-      if (!ui_has_keys) {
-        if (pressed_once(window, GLFW_KEY_TAB, glue.tab_down)) in.switch_hand();
-        if (pressed_once(window, GLFW_KEY_SPACE, glue.space_down)) {
-          session->state() == TrainerState::Paused ? session->resume() : session->pause();
-        }
-        if (pressed_once(window, GLFW_KEY_R, glue.r_down)) session->reset();
-        if (pressed_once(window, GLFW_KEY_G, glue.g_down))
-          renderer.options().guidance = !renderer.options().guidance;
-        if (pressed_once(window, GLFW_KEY_F1, glue.f1_down)) ui.toggle_controls();
-      }
+      read_input(window, glue, o, *session, renderer, ui, frames);
 
       // The view: the newest snapshot the simulation published.
       int fb_w = 0, fb_h = 0;
@@ -377,33 +430,7 @@ int run_trainer(const TrainerOptions& o) {
       }
     }
     session->stop();
-    if (session->unsaved_count() > 0) {
-      // Closing with drills the database refused: never lose them silently. Beside the
-      // database first; where that folder is the problem (read-only, full), the temp folder.
-      std::vector<std::filesystem::path> dirs;
-      try {
-        const auto db = config.records_db.empty() ? default_records_db() : config.records_db;
-        if (!is_postgres_uri(db.string())) dirs.push_back(db.parent_path() / "unsaved");
-      } catch (const InputError&) {
-      }
-      dirs.push_back(std::filesystem::temp_directory_path() / "openphaco-unsaved");
-      std::string why;
-      bool kept = false;
-      for (const auto& dir : dirs) {
-        try {
-          for (const auto& f : session->write_unsaved(dir))
-            std::fprintf(stderr, "phaco-trainer: an unsaved drill is kept in %s\n", f.c_str());
-          kept = true;
-          break;
-        } catch (const InputError& e) {
-          why += std::string(why.empty() ? "" : "; ") + e.what();
-        }
-      }
-      if (!kept) {
-        std::fprintf(stderr, "phaco-trainer: unsaved drills could not be kept: %s\n", why.c_str());
-        exit_code = exit_code == 0 ? 2 : exit_code;
-      }
-    }
+    if (!keep_unsaved(*session, config) && exit_code == 0) exit_code = 2;
   }
   remember_settings(o,
                     config);  // an interactive run's choices, for the next (trainer_settings.hpp)

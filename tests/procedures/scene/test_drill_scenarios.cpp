@@ -69,7 +69,9 @@ TEST_P(DrillScenario, MissesExactlyTheTargetsItsScriptBreaks) {
                             c.missed.count("posterior_capsule.rupture") > 0;
   EXPECT_EQ(r.metrics.value("drill_failed", 0.0) > 0, complication);
   EXPECT_EQ(!r.complications.empty(), complication);
-  if (complication) EXPECT_LE(r.metrics["score"].get<double>(), 40.0);
+  if (complication) {
+    EXPECT_LE(r.metrics["score"].get<double>(), 40.0);
+  }
   EXPECT_EQ(r.metrics.value("attempted", 0.0), 1.0) << "every scripted hand attempts its step";
   if (c.missed.empty()) {
     EXPECT_DOUBLE_EQ(r.metrics["score"].get<double>(), 100.0) << "the expert loses no points";

@@ -393,8 +393,9 @@ TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsR
     const Vec3 centre(h.sphere_x[j], h.sphere_y[j], h.sphere_z[j]);
     for (uint32_t c = 0; c < lf.lens.cells.size(); ++c) {
       if (Vec3(lf.lens.cells.x[c], lf.lens.cells.y[c], lf.lens.cells.z[c]) == centre &&
-          lf.lens.cells.alive[c])
+          lf.lens.cells.alive[c]) {
         EXPECT_NE(lf.lens.fragments.label[c], 0u) << "the held fragment's cells ride the tip";
+      }
     }
   }
 }
