@@ -1,4 +1,5 @@
-// One file for now: the passes share one GL state and its slots; issue 22 splits them by job.
+// One file: the five passes share one GL state, one set of buffers per body slot and the shaders
+// (Renderer::Impl); split, they would share it through a second, internal header for no gain.
 // The microscope view (renderer.hpp). Per view (one, or two for side-by-side stereo) the passes
 // are:
 //   1. opaque tissue: sclera, iris, lens surface (red reflex dimmed by the lens's thickness map,
