@@ -10,6 +10,7 @@
 // sums use parallel_reduce_ordered.
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/parallel_invoke.h>
 #include <oneapi/tbb/parallel_reduce.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
@@ -45,6 +46,12 @@ void parallel_for(uint32_t begin, uint32_t end, uint32_t grain, Fn&& fn) {
         fn(r.begin(), r.end(), tbb::this_task_arena::current_thread_index());
       },
       tbb::simple_partitioner());
+}
+
+// Runs f and g, side by side when a worker is free (tbb::parallel_invoke); returns when both have.
+template <class F, class G>
+void parallel_invoke(F&& f, G&& g) {
+  tbb::parallel_invoke(std::forward<F>(f), std::forward<G>(g));
 }
 
 namespace detail {

@@ -123,10 +123,14 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
   }
   std::sort(set.particles.begin(), set.particles.end());
 
+  // Each spring once: from its lower active end, or from its only active end. Half the entries
+  // to sort of listing it from both ends and removing the duplicates.
   set.spring_scratch.clear();
   for (uint32_t p : set.particles)
-    for (uint32_t k = graph.begin(p); k < graph.end(p); ++k)
-      set.spring_scratch.push_back(graph.spring[k]);
+    for (uint32_t k = graph.begin(p); k < graph.end(p); ++k) {
+      const uint32_t q = graph.neighbour[k];
+      if (q > p || !set.mark[q]) set.spring_scratch.push_back(graph.spring[k]);
+    }
   std::sort(set.spring_scratch.begin(), set.spring_scratch.end());
   const auto last = std::unique(set.spring_scratch.begin(), set.spring_scratch.end());
   set.springs.assign(set.spring_scratch.begin(), last);

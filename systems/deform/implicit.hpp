@@ -25,7 +25,7 @@
 // Δx = dt·(v_n + Δv) above; the step x⁺ = x_n + α·Δx, v⁺ = α·Δx/dt takes the largest α in
 // {1, ½, ¼, ...} with Φ(x⁺) ≤ Φ(x_n). With α = 1 (the usual case) it is Baraff–Witkin's step.
 //
-// The system is solved with Eigen::ConjugateGradient, relative tolerance settings.cg_tolerance
+// The system is solved by preconditioned CG, relative tolerance settings.cg_tolerance
 // (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each particle, preconditioned by
 // settings.preconditioner (implicit_solver.hpp): Jacobi, 3×3 block-Jacobi, incomplete Cholesky
 // of the assembled matrix, or a two-level smoothed-aggregation cycle (Tamstorf, Jones & McCormick
@@ -36,10 +36,16 @@
 // and whose values are refilled every step, or a matrix-free product over the stored 3×3 blocks of
 // the block-CSR rows (the default: ~2× fewer bytes per product; in its earlier scatter-over-springs
 // form it measured 2.2–3.4× faster per step at levels 0–5, docs/implicit_and_active.md). The
-// matrix-free product gathers each row in a fixed order, so it runs on several threads above
-// settings.parallel_min_unknowns and gives the same bits on any thread count. Eigen's CG allocates
-// its four work vectors once per solve, and the factored preconditioners when they are rebuilt;
-// nothing else in a steady-state step allocates.
+// matrix-free product gathers each row in a fixed order, so rows split over threads with the same
+// bits on any thread count.
+// Threads: the row-local preconditioners (Jacobi, block-Jacobi) with the matrix-free operator run
+// the step's assembly and a row-chunked CG on a team of two threads (implicit_team_cg.cpp,
+// engine/schedule/phased_team.hpp), formed before the assembly so that its worker is awake when
+// the CG starts; the other preconditioners and the assembled operator use Eigen's
+// ConjugateGradient, whose product runs on several threads above settings.parallel_min_unknowns.
+// Every sum has a fixed order, so 1 and 2 threads give the same bits. Eigen's CG allocates its
+// four work vectors per solve, the factored preconditioners when they are rebuilt; the
+// row-chunked CG keeps its work vectors in the cache (CgWork) and reuses them.
 //
 // Approximate implicit predictor (seed 004 "pre computes the solution to a linear system [9]",
 // [9] = Desbrun, Schröder & Barr 1999): the system matrix is frozen and factorised once
@@ -99,6 +105,15 @@ struct ImplicitSettings {
   // small active set pays no threading overhead. Measured (docs/implicit_and_active.md).
   uint32_t parallel_min_unknowns = 1024;
   uint32_t parallel_grain_unknowns = 512;
+  // Jacobi and block-Jacobi CG (implicit_team_cg.cpp) works in chunks of this many rows, fixed by
+  // the row count alone so that its sums, hence its bits, do not depend on the threads; a team of
+  // threads works the iterations from this many rows on (below it, the calling thread alone).
+  uint32_t cg_chunk_rows = 128;
+  // Assembly splits its springs and its rows over threads in chunks of these (results do not
+  // depend on the split).
+  uint32_t parallel_grain_springs = 512;
+  uint32_t parallel_grain_rows = 128;
+  uint32_t cg_team_min_rows = 256;
   // TwoLevel: rebuild the hierarchy when more than this fraction of the unknowns entered or left
   // the set since its build (otherwise reuse it stale); a topology change always rebuilds.
   double two_level_rebuild_fraction = 0.2;
@@ -172,6 +187,9 @@ struct BlockPattern {
       spring_uj;  // per step spring: unknown of each end, or kNotUnknown
   std::vector<uint32_t> spring_pos_ij,
       spring_pos_ji;  // per step spring: block of j in i's row and back
+  // Per unknown + 1 / per entry: the step springs at the unknown, in increasing order, as
+  // t·2 + (1 if the unknown is the spring's j end): assembly gathers each row from them.
+  std::vector<uint32_t> row_spring_begin, row_spring;
   uint32_t rows() const {
     return row_begin.empty() ? 0u : static_cast<uint32_t>(row_begin.size() - 1);
   }
@@ -179,14 +197,27 @@ struct BlockPattern {
 
 // This step's system A·Δv = b (A = M(1 + dt(γ+κ)) + dt²(K + g·I), b = dt·(f + dt·K·v), see top).
 struct StepSystem {
-  std::vector<Sym3> spring_k;  // per step spring: ∂f_i/∂x_j, mN/mm
-  std::vector<Sym3> block;     // per block of the pattern: A's 3×3 block, kg (mN·s²/mm)
+  std::vector<Sym3> spring_k;                       // per step spring: ∂f_i/∂x_j, mN/mm
+  std::vector<std::array<double, 3>> spring_force;  // per step spring: its force on i, mN
+  std::vector<std::array<double, 3>>
+      spring_kw;  // per step spring: k·(v_j − v_i), unknown ends only
+  std::vector<std::pair<uint32_t, uint32_t>> loads;  // (unknown, index in Membrane::loads), sorted
+  std::vector<Sym3> block;  // per block of the pattern: A's 3×3 block, kg (mN·s²/mm)
   Eigen::SparseMatrix<double, Eigen::RowMajor, int>
       matrix;                 // assembled A (Assembled operator, factorisations)
   Eigen::VectorXd force;      // 3 per unknown: f at the start of the step, mN
   Eigen::VectorXd rhs;        // 3 per unknown: b, mN·s
   Eigen::VectorXd guess, dv;  // 3 per unknown: CG's first guess and answer Δv, mm/s
   Eigen::VectorXd step_dx;    // 3 per unknown: Newton step Δx = dt·(v + Δv), mm
+};
+
+// Work vectors of the row-chunked CG (implicit_team_cg.cpp), kept between steps: a steady-state
+// solve allocates nothing.
+struct CgWork {
+  std::vector<double> residual, preconditioned, direction, product;  // r, z, p, A·p: 3 per unknown
+  // Per chunk: partial sums, reduced in chunk order. rz is double-buffered by iteration parity:
+  // iteration i reads r·z of the one before while writing its own.
+  std::vector<double> rhs_norm2, residual_norm2, direction_product, rz[2];
 };
 
 // Factorised preconditioner state (implicit_solver.hpp); opaque here to keep Eigen's sparse
@@ -210,6 +241,7 @@ struct ImplicitCache {
   UnknownSet unknowns;
   BlockPattern pattern;
   StepSystem system;
+  CgWork cg;
   std::vector<double> warm_dv;  // 3 per particle: the last Δv (mm/s), CG's first guess
   std::unique_ptr<PreconditionerState, PreconditionerStateDeleter> preconditioner;
 

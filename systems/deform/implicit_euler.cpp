@@ -10,7 +10,11 @@
 //   6. line-search Φ along Δx = dt·(v + Δv) and move the unknowns.
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <utility>
 
+#include "engine/schedule/parallel.hpp"
+#include "engine/schedule/phased_team.hpp"
 #include "systems/deform/implicit.hpp"
 #include "systems/deform/implicit_solver.hpp"
 
@@ -138,18 +142,43 @@ void build_pattern(const Springs& s, ImplicitCache& cache) {
       pattern.col[fill[uj]++] = ui;
     }
   }
-  for (uint32_t u = 0; u < nu; ++u) {
-    std::sort(pattern.col.begin() + pattern.row_begin[u],
-              pattern.col.begin() + pattern.row_begin[u + 1]);
-    pattern.diag_pos[u] = find_in_row(pattern, u, u);
-  }
+  // Rows sort independently, and each spring finds its blocks on its own: both split over threads
+  // (the active set changes in most frames, so this runs in most frames).
+  const ImplicitSettings& settings = cache.settings;
+  parallel_for(0u, nu, settings.parallel_grain_rows, [&pattern](uint32_t b, uint32_t e, int) {
+    for (uint32_t u = b; u < e; ++u) {
+      std::sort(pattern.col.begin() + pattern.row_begin[u],
+                pattern.col.begin() + pattern.row_begin[u + 1]);
+      pattern.diag_pos[u] = find_in_row(pattern, u, u);
+    }
+  });
   pattern.spring_pos_ij.resize(ns);
   pattern.spring_pos_ji.resize(ns);
+  parallel_for(0u, uint32_t(ns), settings.parallel_grain_springs,
+               [&pattern](uint32_t b, uint32_t e, int) {
+                 for (uint32_t t = b; t < e; ++t) {
+                   const uint32_t ui = pattern.spring_ui[t], uj = pattern.spring_uj[t];
+                   const bool both = ui != kNotUnknown && uj != kNotUnknown;
+                   pattern.spring_pos_ij[t] = both ? find_in_row(pattern, ui, uj) : kNotUnknown;
+                   pattern.spring_pos_ji[t] = both ? find_in_row(pattern, uj, ui) : kNotUnknown;
+                 }
+               });
+  // Each row's springs, in increasing t (the order the serial scatter added them in).
+  pattern.row_spring_begin.assign(nu + 1, 0);
   for (size_t t = 0; t < ns; ++t) {
-    const uint32_t ui = pattern.spring_ui[t], uj = pattern.spring_uj[t];
-    const bool both = ui != kNotUnknown && uj != kNotUnknown;
-    pattern.spring_pos_ij[t] = both ? find_in_row(pattern, ui, uj) : kNotUnknown;
-    pattern.spring_pos_ji[t] = both ? find_in_row(pattern, uj, ui) : kNotUnknown;
+    if (pattern.spring_ui[t] != kNotUnknown) ++pattern.row_spring_begin[pattern.spring_ui[t] + 1];
+    if (pattern.spring_uj[t] != kNotUnknown) ++pattern.row_spring_begin[pattern.spring_uj[t] + 1];
+  }
+  for (uint32_t u = 0; u < nu; ++u) pattern.row_spring_begin[u + 1] += pattern.row_spring_begin[u];
+  pattern.row_spring.resize(pattern.row_spring_begin[nu]);
+  {
+    std::vector<uint32_t>& fill = cache.unknowns.candidate_particles;
+    fill.assign(pattern.row_spring_begin.begin(), pattern.row_spring_begin.end() - 1);
+    for (size_t t = 0; t < ns; ++t) {
+      const uint32_t ui = pattern.spring_ui[t], uj = pattern.spring_uj[t];
+      if (ui != kNotUnknown) pattern.row_spring[fill[ui]++] = uint32_t(2 * t);
+      if (uj != kNotUnknown) pattern.row_spring[fill[uj]++] = uint32_t(2 * t + 1);
+    }
   }
   if (cache.settings.cg_operator == CgOperator::Assembled)
     implicit_detail::write_matrix_pattern(pattern, cache.system.matrix);
@@ -167,75 +196,132 @@ inline void add_sym(Sym3& to, const Sym3& k, double s) {
 // A = M·(1 + dt·(γ+κ)) + dt²·(g·I − K): diagonal blocks m(1 + dt(γ+κ))·I + dt²(g·I + Σ k_e),
 // off-diagonal blocks −dt²·k_e. A spring with one fixed end adds to its free end's diagonal only,
 // and its fixed end brings no velocity term.
-void assemble(const Membrane& m, double dt, ImplicitCache& cache) {
+//
+// Two passes, each split over threads (their results do not depend on the split): the springs'
+// forces and blocks, then each row gathered from its own springs in increasing order, which adds
+// the same terms in the same order as one serial scatter over the springs would.
+// Springs [begin, end) of the step: force on i, block k and velocity term k·(v_j − v_i).
+void spring_terms(const Membrane& m, ImplicitCache& cache, uint32_t begin, uint32_t end) {
   const Particles& p = m.particles;
   const Springs& s = m.springs;
+  const UnknownSet& set = cache.unknowns;
+  const BlockPattern& pattern = cache.pattern;
+  StepSystem& sys = cache.system;
+  for (uint32_t t = begin; t < end; ++t) {
+    const uint32_t sp = set.springs[t], i = s.i[sp], j = s.j[sp];
+    const SpringForceJacobian sj = spring_force_jacobian(
+        double(p.x[j]) - p.x[i], double(p.y[j]) - p.y[i], double(p.z[j]) - p.z[i],
+        s.rest_length[sp], s.stiffness[sp], m.dynamics.law);
+    sys.spring_k[t] = sj.k;
+    sys.spring_force[t] = sj.force_on_i;
+    double vi[3] = {0.0, 0.0, 0.0}, vj[3] = {0.0, 0.0, 0.0};
+    if (pattern.spring_ui[t] != kNotUnknown) vi[0] = p.vx[i], vi[1] = p.vy[i], vi[2] = p.vz[i];
+    if (pattern.spring_uj[t] != kNotUnknown) vj[0] = p.vx[j], vj[1] = p.vy[j], vj[2] = p.vz[j];
+    const double w[3] = {vj[0] - vi[0], vj[1] - vi[1], vj[2] - vi[2]};
+    const Sym3& k = sj.k;
+    sys.spring_kw[t] = {k[0] * w[0] + k[1] * w[1] + k[2] * w[2],
+                        k[1] * w[0] + k[3] * w[1] + k[4] * w[2],
+                        k[2] * w[0] + k[4] * w[1] + k[5] * w[2]};
+  }
+}
+
+// The point loads on unknowns as (unknown, load), sorted: each row adds its own in list order.
+void list_point_loads(const Membrane& m, ImplicitCache& cache) {
+  std::vector<std::pair<uint32_t, uint32_t>>& loads = cache.system.loads;
+  loads.clear();
+  const std::vector<uint32_t>& unknown_of = cache.unknowns.unknown_of;
+  for (uint32_t l = 0; l < m.loads.size(); ++l) {
+    const PointLoad& load = m.loads[l];
+    if (load.particle >= unknown_of.size() || unknown_of[load.particle] == kNotUnknown) continue;
+    // Non-finite loads are rejected (and counted) by the guard's force pass; skip them here too.
+    if (!std::isfinite(load.fx) || !std::isfinite(load.fy) || !std::isfinite(load.fz)) continue;
+    loads.emplace_back(unknown_of[load.particle], l);
+  }
+  std::sort(loads.begin(), loads.end());
+}
+
+// Rows [ub, ue): each gathered from its springs in increasing order (see above).
+void row_terms(const Membrane& m, double dt, ImplicitCache& cache, uint32_t ub, uint32_t ue) {
+  const Particles& p = m.particles;
   const Dynamics& dyn = m.dynamics;
   const UnknownSet& set = cache.unknowns;
   const BlockPattern& pattern = cache.pattern;
   StepSystem& sys = cache.system;
-  const size_t nu = set.particles.size(), ns = set.springs.size();
   const double dt2 = dt * dt;
   const double drag = double(dyn.damping_per_s) + dyn.viscosity_per_s;
   const bool glued = m.glue && m.glue->x.size() == p.slots.size();
   const double glue_k = glued ? dyn.glue_stiffness_mn_mm : 0.0;
-  sys.force.resize(3 * nu);
-  sys.rhs.resize(3 * nu);  // accumulates K·v first
-  sys.spring_k.resize(ns);
-  sys.block.assign(pattern.row_begin[nu], Sym3{});
-  for (size_t u = 0; u < nu; ++u) {
+  auto load = std::lower_bound(sys.loads.begin(), sys.loads.end(), std::make_pair(ub, 0u));
+  for (uint32_t u = ub; u < ue; ++u) {
     const uint32_t i = set.particles[u];
     // Mass scaling changes inertia only: the weight stays that of the true mass (docs/dynamics.md).
     const double true_mass = 1.0 / p.inv_mass[i];
     const double mass = implicit_detail::mass_scale(dyn) * true_mass;
     const double v[3] = {p.vx[i], p.vy[i], p.vz[i]};
     const double x[3] = {p.x[i], p.y[i], p.z[i]};
+    double f[3], kv[3];  // f, and K·v (b's velocity term) until b is formed below
     for (int a = 0; a < 3; ++a) {
       const double rest = glued ? (a == 0   ? m.glue->x[i]
                                    : a == 1 ? m.glue->y[i]
                                             : m.glue->z[i])
                                 : x[a];
-      sys.force[3 * u + a] =
-          true_mass * dyn.gravity_mm_s2[a] - mass * drag * v[a] - glue_k * (x[a] - rest);
-      sys.rhs[3 * u + a] = -glue_k * v[a];
+      f[a] = true_mass * dyn.gravity_mm_s2[a] - mass * drag * v[a] - glue_k * (x[a] - rest);
+      kv[a] = -glue_k * v[a];
     }
+    for (; load != sys.loads.end() && load->first == u; ++load) {
+      const PointLoad& pl = m.loads[load->second];
+      f[0] += pl.fx, f[1] += pl.fy, f[2] += pl.fz;
+    }
+    Sym3* row = sys.block.data() + pattern.row_begin[u];
+    std::fill(row, sys.block.data() + pattern.row_begin[u + 1], Sym3{});
     const double d = mass * (1.0 + dt * drag) + dt2 * glue_k;
-    sys.block[pattern.row_begin[u] + pattern.diag_pos[u]] = {d, 0.0, 0.0, d, 0.0, d};
-  }
-  implicit_detail::add_point_loads(m, set.unknown_of, sys.force.data());
-  for (size_t t = 0; t < ns; ++t) {
-    const uint32_t e = set.springs[t], i = s.i[e], j = s.j[e];
-    const SpringForceJacobian sj =
-        spring_force_jacobian(double(p.x[j]) - p.x[i], double(p.y[j]) - p.y[i],
-                              double(p.z[j]) - p.z[i], s.rest_length[e], s.stiffness[e], dyn.law);
-    sys.spring_k[t] = sj.k;
-    const uint32_t ui = pattern.spring_ui[t], uj = pattern.spring_uj[t];
-    double vi[3] = {0.0, 0.0, 0.0}, vj[3] = {0.0, 0.0, 0.0};
-    if (ui != kNotUnknown) vi[0] = p.vx[i], vi[1] = p.vy[i], vi[2] = p.vz[i];
-    if (uj != kNotUnknown) vj[0] = p.vx[j], vj[1] = p.vy[j], vj[2] = p.vz[j];
-    const double w[3] = {vj[0] - vi[0], vj[1] - vi[1], vj[2] - vi[2]};
-    const Sym3& k = sj.k;
-    const double kw[3] = {k[0] * w[0] + k[1] * w[1] + k[2] * w[2],
-                          k[1] * w[0] + k[3] * w[1] + k[4] * w[2],
-                          k[2] * w[0] + k[4] * w[1] + k[5] * w[2]};
-    if (ui != kNotUnknown) {
+    Sym3& diagonal = row[pattern.diag_pos[u]];
+    diagonal = {d, 0.0, 0.0, d, 0.0, d};
+    for (uint32_t r = pattern.row_spring_begin[u]; r < pattern.row_spring_begin[u + 1]; ++r) {
+      const uint32_t t = pattern.row_spring[r] >> 1;
+      const double sign = (pattern.row_spring[r] & 1u) ? -1.0 : 1.0;  // the j end: −force
       for (int a = 0; a < 3; ++a)
-        sys.force[3 * ui + a] += sj.force_on_i[a], sys.rhs[3 * ui + a] += kw[a];
-      add_sym(sys.block[pattern.row_begin[ui] + pattern.diag_pos[ui]], k, dt2);
+        f[a] += sign * sys.spring_force[t][a], kv[a] += sign * sys.spring_kw[t][a];
+      const Sym3& k = sys.spring_k[t];
+      add_sym(diagonal, k, dt2);
+      if (pattern.spring_ui[t] != kNotUnknown && pattern.spring_uj[t] != kNotUnknown)
+        add_sym(row[sign > 0.0 ? pattern.spring_pos_ij[t] : pattern.spring_pos_ji[t]], k, -dt2);
     }
-    if (uj != kNotUnknown) {
-      for (int a = 0; a < 3; ++a)
-        sys.force[3 * uj + a] -= sj.force_on_i[a], sys.rhs[3 * uj + a] -= kw[a];
-      add_sym(sys.block[pattern.row_begin[uj] + pattern.diag_pos[uj]], k, dt2);
-    }
-    if (ui != kNotUnknown && uj != kNotUnknown) {
-      add_sym(sys.block[pattern.row_begin[ui] + pattern.spring_pos_ij[t]], k, -dt2);
-      add_sym(sys.block[pattern.row_begin[uj] + pattern.spring_pos_ji[t]], k, -dt2);
+    for (int a = 0; a < 3; ++a) {
+      sys.force[3 * u + a] = f[a];
+      sys.rhs[3 * u + a] = dt * f[a] + dt2 * kv[a];
     }
   }
-  sys.rhs = dt * sys.force + dt2 * sys.rhs;
+}
+
+// Two phases on the step's team: the springs, then the rows, each in an even number of equal
+// chunks (the team's two threads start from opposite ends).
+void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& team) {
+  const uint32_t nu = static_cast<uint32_t>(cache.unknowns.particles.size());
+  const uint32_t ns = static_cast<uint32_t>(cache.unknowns.springs.size());
+  StepSystem& sys = cache.system;
+  sys.spring_k.resize(ns);
+  sys.spring_force.resize(ns);
+  sys.spring_kw.resize(ns);
+  list_point_loads(m, cache);
+  sys.force.resize(3 * nu);
+  sys.rhs.resize(3 * nu);
+  sys.block.resize(cache.pattern.row_begin[nu]);
+  uint32_t chunks = std::max(1u, (nu + cache.settings.parallel_grain_rows - 1) /
+                                     std::max(cache.settings.parallel_grain_rows, 1u));
+  if (chunks > 1 && chunks % 2 == 1) ++chunks;
+  const uint32_t rows_per = (nu + chunks - 1) / chunks, springs_per = (ns + chunks - 1) / chunks;
+  team.run(
+      chunks, 2, [](uint64_t) { return true; },
+      [&](uint64_t phase, uint32_t c) {
+        if (phase == 0)
+          spring_terms(m, cache, std::min(ns, c * springs_per),
+                       std::min(ns, (c + 1) * springs_per));
+        else
+          row_terms(m, dt, cache, std::min(nu, c * rows_per), std::min(nu, (c + 1) * rows_per));
+      });
   if (cache.settings.cg_operator == CgOperator::Assembled)
-    implicit_detail::write_matrix_values(pattern, sys.block, sys.matrix);
+    implicit_detail::write_matrix_values(cache.pattern, sys.block, sys.matrix);
 }
 
 }  // namespace
@@ -257,7 +343,15 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
     cache.stats.cg_iterations = 0, cache.stats.cg_residual = 0.0, cache.stats.cg_converged = true;
     return;
   }
-  assemble(m, dt, cache);
+  // A team for the assembly and the solve, formed now: its worker wakes while this thread selects
+  // and assembles (engine/schedule/phased_team.hpp). Let go before the solve if the solve is
+  // Eigen's, whose parallel loops need the worker free.
+  std::optional<PhasedTeam> team;
+  team.emplace(nu >= cache.settings.cg_team_min_rows);
+  assemble(m, dt, cache, *team);
+  const bool row_chunked = cache.settings.cg_operator == CgOperator::MatrixFree &&
+                           implicit_detail::row_local_preconditioner(cache.settings.preconditioner);
+  if (!row_chunked) team.reset();
   // Step 4. Diagonal preconditioners follow A every step; a factored one is rebuilt with the
   // pattern only (a stale factor is still SPD: CG stays valid, only its speed depends on it).
   implicit_detail::update_preconditioner(cache);
@@ -269,7 +363,8 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
       sys.guess[3 * u + a] =
           cache.settings.warm_start ? cache.warm_dv[3 * set.particles[u] + a] : 0.0;
   // Step 5. CG to the relative tolerance (implicit_solver.hpp: operator and preconditioners).
-  implicit_detail::solve_linear_system(cache);
+  implicit_detail::solve_linear_system(cache, team ? &*team : nullptr);
+  team.reset();
   cache.stats.cg_iterations_total += cache.stats.cg_iterations;
 
   // Step 6. The linear solve is one Newton step of the incremental potential Φ (Gast et al. 2015);

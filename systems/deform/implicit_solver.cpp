@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "engine/schedule/parallel.hpp"
+#include "engine/schedule/phased_team.hpp"
 
 namespace phaco::deform {
 
@@ -260,15 +261,9 @@ void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks
                        double* y, double alpha, const ImplicitSettings& settings) {
   for_rows(pattern.rows(), settings, [&](uint32_t begin, uint32_t end) {
     for (uint32_t u = begin; u < end; ++u) {
-      double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-      for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
-        const Sym3& k = blocks[b];
-        const double* xw = x + 3 * size_t(pattern.col[b]);
-        s0 += k[0] * xw[0] + k[1] * xw[1] + k[2] * xw[2];
-        s1 += k[1] * xw[0] + k[3] * xw[1] + k[4] * xw[2];
-        s2 += k[2] * xw[0] + k[4] * xw[1] + k[5] * xw[2];
-      }
-      y[3 * u] += alpha * s0, y[3 * u + 1] += alpha * s1, y[3 * u + 2] += alpha * s2;
+      double s[3];
+      block_row_product(pattern, blocks.data(), x, u, s);
+      y[3 * u] += alpha * s[0], y[3 * u + 1] += alpha * s[1], y[3 * u + 2] += alpha * s[2];
     }
   });
 }
@@ -367,8 +362,20 @@ void solve_with(const Operator& op, ImplicitCache& cache) {
 
 }  // namespace
 
-void solve_linear_system(ImplicitCache& cache) {
-  if (cache.settings.cg_operator == CgOperator::Assembled)
+bool row_local_preconditioner(Preconditioner p) {
+  return p == Preconditioner::Jacobi || p == Preconditioner::BlockJacobi;
+}
+
+void solve_linear_system(ImplicitCache& cache, PhasedTeam* team) {
+  if (cache.settings.cg_operator == CgOperator::MatrixFree &&
+      row_local_preconditioner(cache.settings.preconditioner)) {
+    if (team) {
+      solve_row_chunked(cache, *team);
+    } else {
+      PhasedTeam own(cache.pattern.rows() >= cache.settings.cg_team_min_rows);
+      solve_row_chunked(cache, own);
+    }
+  } else if (cache.settings.cg_operator == CgOperator::Assembled)
     solve_with(cache.system.matrix, cache);
   else
     solve_with(BlockOperator(cache), cache);

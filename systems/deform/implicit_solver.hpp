@@ -44,6 +44,10 @@
 
 #include "systems/deform/implicit.hpp"
 
+namespace phaco {
+class PhasedTeam;  // engine/schedule/phased_team.hpp
+}  // namespace phaco
+
 namespace phaco::deform::implicit_detail {
 class BlockOperator;
 }  // namespace phaco::deform::implicit_detail
@@ -79,6 +83,21 @@ struct PreconditionerState {
 
 namespace implicit_detail {
 
+// Row u of A·x, s = Σ_w A_uw·x_w over the row's blocks in their fixed order: every product of A
+// sums a row this way, so a row's bits never depend on who computes it.
+inline void block_row_product(const BlockPattern& pattern, const Sym3* blocks, const double* x,
+                              uint32_t u, double s[3]) {
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+  for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
+    const Sym3& k = blocks[b];
+    const double* xw = x + 3 * size_t(pattern.col[b]);
+    s0 += k[0] * xw[0] + k[1] * xw[1] + k[2] * xw[2];
+    s1 += k[1] * xw[0] + k[3] * xw[1] + k[4] * xw[2];
+    s2 += k[2] * xw[0] + k[4] * xw[1] + k[5] * xw[2];
+  }
+  s[0] = s0, s[1] = s1, s[2] = s2;
+}
+
 // y += alpha·A·x over the pattern's rows; x and y hold 3 per unknown. Parallel above
 // settings.parallel_min_unknowns, bit-identical to the serial loop.
 void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks, const double* x,
@@ -100,10 +119,24 @@ void update_preconditioner(ImplicitCache& cache);
 // ‖A·Δv − b‖ ≤ settings.cg_tolerance·‖b‖ (Eigen's criterion), with the operator and preconditioner
 // the settings choose; writes system.dv and the CG fields of stats (not the totals). Call
 // update_preconditioner first.
-void solve_linear_system(ImplicitCache& cache);
+// `team`: the team the step formed before its assembly (implicit_euler.cpp); without one, the
+// row-chunked CG forms its own.
+void solve_linear_system(ImplicitCache& cache, PhasedTeam* team = nullptr);
 
 // z = B⁻¹·r, B the cache's preconditioner.
 void apply_preconditioner(const ImplicitCache& cache, const double* r, double* z);
+
+// Whether the preconditioner acts row by row (Jacobi, block-Jacobi): then the solve runs as the
+// row-chunked CG below, else as Eigen's.
+bool row_local_preconditioner(Preconditioner p);
+
+// Step 5 for a row-local preconditioner and the matrix-free operator: Eigen's preconditioned CG
+// (same iterates, same stopping rule, same iteration count), worked in chunks of
+// settings.cg_chunk_rows rows by a team of threads (engine/schedule/phased_team.hpp). Each
+// iteration is three phases: q = A·p with p·q; the updates of x and r, z = B⁻¹·r with r·r and r·z;
+// p = z + β·p. Dot products are summed per chunk and the chunks in order, so the bits are the
+// same on any thread count (but not Eigen's, whose dot products sum in another order).
+void solve_row_chunked(ImplicitCache& cache, PhasedTeam& team);
 
 // Matrix-free A over the cache's blocks (Eigen's documented matrix-free pattern: an EigenBase with
 // a custom GEMV product, specialised below).

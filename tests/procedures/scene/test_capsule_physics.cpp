@@ -41,12 +41,15 @@ Outcome run(const std::string& preconditioner, int threads) {
   o.threads = threads;
   o.cache_dir = cache_dir();
   auto scene = build_scene(grasp_scenario(preconditioner), o);
-  // Thread every row loop of the solve, whatever the active set's size, so that two threads
-  // really split the product and the preconditioners.
+  // Thread every row loop of the step, whatever the active set's size, so that two threads really
+  // split the assembly, the product, the preconditioners and the row-chunked CG.
   deform::ImplicitSettings& settings =
       scene->world.at<CapsuleSolver>(*scene->body(BodyPart::Capsule)).state.implicit.settings;
   settings.parallel_min_unknowns = 0;
   settings.parallel_grain_unknowns = 8;
+  settings.cg_team_min_rows = 0;  // a team of two for the assembly and the row-chunked CG
+  settings.parallel_grain_rows = 8;
+  settings.parallel_grain_springs = 16;
   for (uint64_t f = 0; f < scene->scenario.frame_count(); ++f) step(*scene);
   return {state_hash(*scene), capsule_physics_summary(*scene)};
 }

@@ -155,10 +155,15 @@ TEST(ImplicitSolver, TwoLevelOutlivesSmallChangesOfTheSet) {
   EXPECT_EQ(cache.stats.preconditioner_builds, 2u);
 }
 
-// Threaded settings: every row loop splits into chunks of 16 rows.
+// Threaded settings: every row loop splits into chunks of 16 rows, and the step forms its team
+// (assembly and the row-chunked CG) whatever the set's size. The CG's chunks stay as they are:
+// they decide the order of its sums, hence its bits (the threads never do).
 void thread_everything(ImplicitCache& cache) {
   cache.settings.parallel_min_unknowns = 0;
   cache.settings.parallel_grain_unknowns = 16;
+  cache.settings.cg_team_min_rows = 0;
+  cache.settings.parallel_grain_rows = 16;
+  cache.settings.parallel_grain_springs = 32;
 }
 
 TEST(ImplicitSolver, ParallelProductAndPreconditionersGiveTheSerialBits) {
@@ -217,6 +222,53 @@ TEST(ImplicitSolver, StepsAreBitIdenticalOnOneAndTwoThreads) {
     EXPECT_EQ(hashes[0], hashes[1]);
     EXPECT_EQ(hashes[0], hashes[2]);
   }
+}
+
+// The row-chunked CG (Jacobi, block-Jacobi with the matrix-free operator) is Eigen's CG with its
+// vector sums taken in another order: on the same system, from the same guess, it takes the same
+// number of iterations (give or take rounding at the last one) and reaches the same answer, on one
+// thread or on a team of two.
+TEST(ImplicitSolver, RowChunkedCgFollowsEigensCg) {
+  Body b = implicit_test::make_capsule(1, 2000.0, 0.02);
+  b.dynamics.gravity_mm_s2 = {0.0f, 0.0f, -9810.0f};
+  ImplicitCache cache = assembled(b);
+  ASSERT_GT(cache.pattern.rows(), 1000u);
+  for (Preconditioner p : {Preconditioner::Jacobi, Preconditioner::BlockJacobi}) {
+    SCOPED_TRACE(std::string(deform::to_string(p)));
+    cache.settings.cg_operator = deform::CgOperator::Assembled;  // Eigen's CG
+    deform::implicit_detail::write_matrix_pattern(cache.pattern, cache.system.matrix);
+    deform::implicit_detail::write_matrix_values(cache.pattern, cache.system.block,
+                                                 cache.system.matrix);
+    const Solved eigen = solve_from_zero(cache, p);
+    cache.settings.cg_operator = deform::CgOperator::MatrixFree;  // row-chunked
+    const Solved chunked = solve_from_zero(cache, p);
+    thread_everything(cache);
+    tbb::task_arena two(2);
+    Solved team;
+    two.execute([&] { team = solve_from_zero(cache, p); });
+    std::printf("[ figures  ] %s: Eigen %d iterations, row-chunked %d (team of two: %d)\n",
+                std::string(deform::to_string(p)).c_str(), eigen.iterations, chunked.iterations,
+                team.iterations);
+    ASSERT_TRUE(eigen.converged);
+    EXPECT_TRUE(chunked.converged);
+    EXPECT_LE(std::abs(chunked.iterations - eigen.iterations), 2);
+    EXPECT_LT((chunked.dv - eigen.dv).norm(), 1e-4 * eigen.dv.norm());
+    EXPECT_EQ(team.iterations, chunked.iterations);
+    EXPECT_EQ(std::memcmp(team.dv.data(), chunked.dv.data(), sizeof(double) * team.dv.size()), 0)
+        << "a team of two gives the bits of one thread";
+    cache.settings = deform::ImplicitSettings{};
+  }
+}
+
+// The iteration limit stops the row-chunked CG where Eigen's stops, and says it did not converge.
+TEST(ImplicitSolver, RowChunkedCgStopsAtTheIterationLimit) {
+  Body b = stiff_membrane(21);
+  ImplicitCache cache = assembled(b);
+  cache.settings.cg_max_iterations = 5;
+  const Solved s = solve_from_zero(cache, Preconditioner::BlockJacobi);
+  EXPECT_EQ(s.iterations, 5);
+  EXPECT_FALSE(s.converged);
+  EXPECT_TRUE(s.dv.allFinite());
 }
 
 // A cut appends particles: the per-particle arrays grow, the unknown set and its pattern stay,
