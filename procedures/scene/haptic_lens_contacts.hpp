@@ -50,7 +50,11 @@ struct HapticLensSettings {
 
 struct HapticLensScratch {
   std::vector<uint32_t> queue, candidates;
-  std::vector<std::pair<float, uint32_t>> near;  // squared distance to the tip, element
+  std::vector<std::pair<float, uint32_t>> near;  // gap to the tip (mm), element
+  // The mean equal-volume radius (mm) of the tets lens of `tets_of` tets: where the search for
+  // the nearest surface tets starts, and its margin. Found once per lens.
+  double mean_radius_mm = 0.0;
+  uint32_t tets_of = 0;
 };
 
 HapticLensSettings haptic_lens_settings(const Scene& scene);
