@@ -10,6 +10,7 @@
 #include <imgui_internal.h>  // the panels' rectangles, for the clutch
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
@@ -76,22 +77,69 @@ struct InputGlue {
   int64_t ui_state_ns = 0;  // when --ui-state was last written
 };
 
-// Whether (x, y) px lies on a panel (any ImGui window shown last frame, popups included): there the
-// pointer works the panel, not the tool.
-bool over_panel(double x, double y) {
-  const ImVec2 p(static_cast<float>(x), static_cast<float>(y));
+// The panels shown last frame (every ImGui window, popups included), in window pixels.
+void panel_rects(std::vector<render::PixelRect>& out) {
+  out.clear();
   for (const ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
-    if (w->Active && !w->Hidden && w->Rect().Contains(p)) return true;
+    if (w->Active && !w->Hidden)
+      out.push_back({w->Pos.x, w->Pos.y, w->Pos.x + w->Size.x, w->Pos.y + w->Size.y});
+}
+
+// Whether (x, y) px lies on a panel: there the pointer works the panel, not the tool.
+bool over_panel(const std::vector<render::PixelRect>& panels, double x, double y) {
+  for (const render::PixelRect& r : panels)
+    if (x >= r.x0 && x < r.x1 && y >= r.y0 && y < r.y1) return true;
   return false;
 }
 
+// Where the view is hidden under the panels (opaque and square: start_imgui, render_panels), in
+// framebuffer pixels.
+void covered_by_panels(const std::vector<render::PixelRect>& panels,
+                       std::vector<render::PixelRect>& out) {
+  const ImVec2 k = ImGui::GetIO().DisplayFramebufferScale;
+  out.clear();
+  for (const render::PixelRect& p : panels)
+    out.push_back({p.x0 * k.x, p.y0 * k.y, p.x1 * k.x, p.y1 * k.y});
+}
+
+// ImGui's draw lists, each window's background first as a flat opaque rectangle of `bg` (ImGui's
+// own is turned off in start_imgui): on llvmpipe a blended, textured panel background costs
+// several times the flat one. List by list, so a window in front still covers the one behind.
+void render_panels(render::Renderer& renderer, const std::array<float, 4>& bg, int fb_w, int fb_h) {
+  const ImDrawData* all = ImGui::GetDrawData();
+  const ImVec2 k = all->FramebufferScale;
+  for (int i = 0; i < all->CmdListsCount; ++i) {
+    ImDrawList* list = all->CmdLists[i];
+    const ImGuiWindow* w = list->_OwnerName ? ImGui::FindWindowByName(list->_OwnerName) : nullptr;
+    constexpr ImGuiWindowFlags kOwnBg =
+        ImGuiWindowFlags_ChildWindow | ImGuiWindowFlags_Popup | ImGuiWindowFlags_Tooltip;
+    if (w && w->Active && !w->Hidden && !w->Collapsed && !(w->Flags & kOwnBg)) {
+      // Where ImGui puts it: below the title bar.
+      const render::PixelRect r{w->Pos.x * k.x, (w->Pos.y + w->TitleBarHeight()) * k.y,
+                                (w->Pos.x + w->Size.x) * k.x, (w->Pos.y + w->Size.y) * k.y};
+      renderer.fill({&r, 1}, bg, fb_w, fb_h);
+    }
+    ImDrawData one = *all;
+    one.CmdLists = &list;
+    one.CmdListsCount = 1;
+    one.TotalVtxCount = list->VtxBuffer.Size;
+    one.TotalIdxCount = list->IdxBuffer.Size;
+    ImGui_ImplOpenGL3_RenderDrawData(&one);
+  }
+}
+
 // The panels' font: DejaVu Sans (Debian's fonts-dejavu-core) has the range and unit signs
-// (≥ – ° µ) the Result table prints; without it ImGui's built-in font (ASCII and Latin-1).
+// (≥ – ° µ) the Result table prints; without it ImGui's built-in font (ASCII and Latin-1). Its
+// glyphs are rasterised at the pixel grid (no horizontal oversampling, snapped advances), as the
+// built-in font's are, so the atlas can be sampled nearest (start_imgui).
 void load_font() {
   static const ImWchar kRanges[] = {0x0020, 0x00FF, 0x2013, 0x2014, 0x2264, 0x2265, 0};
   const char* const path = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+  ImFontConfig config;
+  config.OversampleH = 1;
+  config.PixelSnapH = true;
   if (std::filesystem::exists(path))
-    ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 14.0f, nullptr, kRanges);
+    ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 14.0f, &config, kRanges);
 }
 
 void write_ui_state(const std::filesystem::path& file, const nlohmann::json& j) {
@@ -192,7 +240,7 @@ SoakSample soak_sample(const nlohmann::json& r, const std::string& drill, size_t
 // window, on no panel).
 void read_input(GLFWwindow* window, InputGlue& glue, const TrainerOptions& o,
                 TrainerSession& session, render::Renderer& renderer, TrainerUi& ui,
-                const FrameClock& frames) {
+                const FrameClock& frames, const std::vector<render::PixelRect>& panels) {
   const bool ui_has_mouse = o.ui && ImGui::GetIO().WantCaptureMouse;
   const bool ui_has_keys = o.ui && ImGui::GetIO().WantCaptureKeyboard;
 
@@ -202,7 +250,7 @@ void read_input(GLFWwindow* window, InputGlue& glue, const TrainerOptions& o,
   int win_w = 0, win_h = 0;
   glfwGetWindowSize(window, &win_w, &win_h);
   const bool in_view =
-      x >= 0 && y >= 0 && x < win_w && y < win_h && !ui_has_mouse && !(o.ui && over_panel(x, y));
+      x >= 0 && y >= 0 && x < win_w && y < win_h && !ui_has_mouse && !over_panel(panels, x, y);
   const bool clutch_held = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS ||
                            glfwGetKey(window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
                            glfwGetKey(window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
@@ -283,14 +331,33 @@ GLFWwindow* open_window(const TrainerOptions& o, InputGlue& glue) {
   return window;
 }
 
-// Dear ImGui on the window: no imgui.ini beside the user's files, the panels' font.
-void start_imgui(GLFWwindow* window, const TrainerOptions& o) {
+// Dear ImGui on the window: no imgui.ini beside the user's files, the panels' font. Returns the
+// panels' background colour, which render_panels draws.
+std::array<float, 4> start_imgui(GLFWwindow* window, const TrainerOptions& o) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  // Opaque panels, so the renderer can leave the view under them unshaded (covered_by_panels).
+  ImGuiStyle& style = ImGui::GetStyle();
+  for (ImGuiCol c : {ImGuiCol_WindowBg, ImGuiCol_PopupBg, ImGuiCol_TitleBgCollapsed})
+    style.Colors[c].w = 1.0f;
+  const ImVec4 bg = style.Colors[ImGuiCol_WindowBg];
+  style.Colors[ImGuiCol_WindowBg].w = 0.0f;  // ImGui draws none: render_panels does
+  style.WindowRounding = 0.0f;               // as render_panels and covered_by_panels draw them
   if (o.ui) load_font();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330");
+  // Every glyph and panel lands on whole pixels (ImGui floors text and window positions), so the
+  // atlas sampled nearest draws what bilinear filtering would, for a quarter of llvmpipe's texel
+  // fetches; lines are anti-aliased by geometry, not by filtering the atlas's baked lines.
+  ImGui_ImplOpenGL3_CreateDeviceObjects();
+  glBindTexture(GL_TEXTURE_2D,
+                static_cast<GLuint>(reinterpret_cast<intptr_t>(ImGui::GetIO().Fonts->TexID)));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  style.AntiAliasedLinesUseTex = false;
+  return {bg.x, bg.y, bg.z, 1.0f};
 }
 
 }  // namespace
@@ -302,7 +369,7 @@ int run_trainer(const TrainerOptions& o) {
   Glfw glfw;
   InputGlue glue;
   GLFWwindow* window = open_window(o, glue);
-  start_imgui(window, o);
+  const std::array<float, 4> panel_bg = start_imgui(window, o);
 
   int exit_code = 0;
   {
@@ -322,6 +389,7 @@ int run_trainer(const TrainerOptions& o) {
       ui.set_sync(sync.get());
     }
     FrameClock frames;
+    std::vector<render::PixelRect> panels, covered;  // last frame's panels; the view they hide
     const int64_t t0 = now_ns();
     const auto wall_s = [&] { return static_cast<double>(now_ns() - t0) * 1e-9; };
 
@@ -362,7 +430,11 @@ int run_trainer(const TrainerOptions& o) {
         continue;
       }
       if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
-      read_input(window, glue, o, *session, renderer, ui, frames);
+      if (o.ui) {
+        panel_rects(panels);
+        covered_by_panels(panels, covered);
+      }
+      read_input(window, glue, o, *session, renderer, ui, frames, panels);
 
       // The view: the newest snapshot the simulation published.
       int fb_w = 0, fb_h = 0;
@@ -389,7 +461,7 @@ int run_trainer(const TrainerOptions& o) {
                     wall_s(), o.screenshot->c_str());
         break;
       }
-      if (snap && o.render) renderer.draw(*snap, microscope, fb_w, fb_h);
+      if (snap && o.render) renderer.draw(*snap, microscope, fb_w, fb_h, covered);
 
       if (o.ui) {
         ImGui_ImplOpenGL3_NewFrame();
@@ -404,7 +476,7 @@ int run_trainer(const TrainerOptions& o) {
           session->start();
         }
         ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        render_panels(renderer, panel_bg, fb_w, fb_h);
         if (o.ui_state && now_ns() - glue.ui_state_ns > 100'000'000) {
           write_ui_state(*o.ui_state, ui.state_json(*session, session->newest_snapshot()));
           glue.ui_state_ns = now_ns();

@@ -105,7 +105,6 @@ void controls_window(const Scenario& scenario, bool& open) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(display.x * 0.5f, display.y * 0.5f), ImGuiCond_Appearing,
                           ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowBgAlpha(0.92f);
   const std::string title = "Controls: " + std::string(to_string(scenario.drill)) + "###controls";
   if (!ImGui::Begin(title.c_str(), &open, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::End();

@@ -9,6 +9,8 @@
 //   4. translucent membranes: capsule (pulled forward by a polygon offset: it lies on the lens),
 //      its cut edges as ribbons, then the cornea (front faces only)
 //   5. overlays without depth test: guidance cues and contact rings
+// Before them, panels that will cover parts of the window are written to the depth buffer at the
+// near plane, so no pass shades what they hide.
 // Buffers are kept per body slot and grow only when a count grows; index buffers are re-sent only
 // when a body's topology_version changes; positions and normals are re-sent every frame.
 #include "engine/render/renderer.hpp"
@@ -20,6 +22,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "engine/render/lens_reflex.hpp"
 #include "engine/render/procedural.hpp"
@@ -164,6 +167,9 @@ struct Renderer::Impl {
   ToolSlot tool_bodies[6], tool_jaw;
   GLuint overlay_vao = 0, overlay_vbo = 0;
   size_t overlay_capacity = 0;  // vertices
+  GLuint cover_vao = 0, cover_vbo = 0;
+  size_t cover_bytes = 0;
+  std::vector<float> cover_xyz;  // the covered rectangles' triangles, clip space
   std::vector<OverlayVertex> overlay;
   std::vector<uint32_t> sclera_tris;  // scratch of sclera_outside()
   size_t edges_end = 0;  // overlay[0, edges_end): cut edges (depth tested); the rest on top
@@ -467,6 +473,52 @@ struct Renderer::Impl {
     }
   }
 
+  // `rects` as triangles at the near plane (clip z −1, depth 0) into cover_vbo; the vertex count.
+  // The colour attribute is the constant `rgba`.
+  size_t rect_triangles(std::span<const PixelRect> rects, int width, int height,
+                        const std::array<float, 4>& rgba, FrameStats& stats) {
+    cover_xyz.clear();
+    const float w = static_cast<float>(width), h = static_cast<float>(height);
+    for (const PixelRect& r : rects) {
+      const float x0 = std::clamp(r.x0, 0.0f, w), x1 = std::clamp(r.x1, 0.0f, w);
+      const float y0 = std::clamp(r.y0, 0.0f, h), y1 = std::clamp(r.y1, 0.0f, h);
+      if (!(x1 > x0 && y1 > y0)) continue;  // empty, off the window, or NaN
+      // Clip space: x right, y up (pixel rows grow downward).
+      const float l = 2 * x0 / w - 1, rt = 2 * x1 / w - 1, top = 1 - 2 * y0 / h,
+                  bottom = 1 - 2 * y1 / h;
+      const std::pair<float, float> corners[6] = {{l, bottom}, {rt, bottom}, {rt, top},
+                                                  {l, bottom}, {rt, top},    {l, top}};
+      for (const auto& [x, y] : corners) cover_xyz.insert(cover_xyz.end(), {x, y, -1.0f});
+    }
+    if (cover_xyz.empty()) return 0;
+    upload(GL_ARRAY_BUFFER, cover_vbo, cover_xyz.data(), cover_xyz.size() * sizeof(float),
+           cover_bytes, stats);
+    glUseProgram(overlay_program);
+    set_mat4(overlay_program, "u_view_proj", Mat4f::Identity());
+    glBindVertexArray(cover_vao);
+    glVertexAttrib4f(1, rgba[0], rgba[1], rgba[2], rgba[3]);
+    const size_t n = cover_xyz.size() / 3;
+    ++stats.draw_calls;
+    stats.triangles += static_cast<uint32_t>(n / 3);
+    return n;
+  }
+
+  // The covered rectangles into the depth buffer at the near plane, colour untouched: every later
+  // pass's depth test (GL_LEQUAL) then fails there before its fragment shader runs.
+  void cover(std::span<const PixelRect> rects, int width, int height, FrameStats& stats) {
+    const size_t n = rect_triangles(rects, width, height, {0, 0, 0, 0}, stats);
+    if (n == 0) return;
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(n));
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(0);
+  }
+
   void draw_view(const RenderSnapshot& s, const Microscope& m, const RenderOptions& options,
                  const Camera& cam, const Eigen::Affine3d& eye, FrameStats& stats) {
     const Mat4f eye_m = to_mat4(eye);
@@ -631,6 +683,12 @@ Renderer::Renderer(const RenderOptions& options) : impl_(new Impl), options_(opt
     glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, stride,
                           reinterpret_cast<const void*>(3 * sizeof(float)));
     glEnableVertexAttribArray(1);
+    glGenVertexArrays(1, &im.cover_vao);
+    glGenBuffers(1, &im.cover_vbo);
+    glBindVertexArray(im.cover_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, im.cover_vbo);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(0);  // the colour (attribute 1) is a constant: rect_triangles
     glBindVertexArray(0);
     im.overlay.reserve(8192);
   } catch (...) {
@@ -658,12 +716,14 @@ Renderer::~Renderer() {
   }
   glDeleteVertexArrays(1, &im.overlay_vao);
   glDeleteBuffers(1, &im.overlay_vbo);
+  glDeleteVertexArrays(1, &im.cover_vao);
+  glDeleteBuffers(1, &im.cover_vbo);
   im.lens_map.reset();
   delete impl_;
 }
 
 FrameStats Renderer::draw(const RenderSnapshot& snapshot, const Microscope& microscope, int width,
-                          int height) {
+                          int height, std::span<const PixelRect> covered) {
   FrameStats stats;
   Impl& im = *impl_;
   if (width <= 0 || height <= 0) return stats;
@@ -694,6 +754,7 @@ FrameStats Renderer::draw(const RenderSnapshot& snapshot, const Microscope& micr
   glScissor(0, 0, width, height);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
   glDisable(GL_SCISSOR_TEST);
+  im.cover(covered, width, height, stats);
 
   if (!stereo) {
     im.draw_view(snapshot, microscope, options_, make_camera(microscope, 0, width, height), eye,
@@ -712,6 +773,21 @@ FrameStats Renderer::draw(const RenderSnapshot& snapshot, const Microscope& micr
     }
     glViewport(0, 0, width, height);
   }
+  glUseProgram(0);
+  return stats;
+}
+
+FrameStats Renderer::fill(std::span<const PixelRect> rects, const std::array<float, 4>& rgba,
+                          int width, int height) {
+  FrameStats stats;
+  if (width <= 0 || height <= 0) return stats;
+  const size_t n = impl_->rect_triangles(rects, width, height, rgba, stats);
+  if (n == 0) return stats;
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(n));
+  glBindVertexArray(0);
   glUseProgram(0);
   return stats;
 }

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,6 +42,12 @@ struct RenderOptions {
   bool blue_iris = false;  // iris texture: brown (default) or blue
 };
 
+// A rectangle of the window in pixels (row 0 at the top) that something opaque drawn after the
+// view will cover, such as the trainer's panels.
+struct PixelRect {
+  float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 struct FrameStats {
   uint32_t triangles = 0;  // drawn this frame
   uint32_t draw_calls = 0;
@@ -56,8 +63,16 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Draws the snapshot into the current framebuffer's (0, 0, width, height).
+  // Draws the snapshot into the current framebuffer's (0, 0, width, height). `covered`: parts of
+  // it that will be painted over opaquely; the view is not shaded there (a depth pre-pass at the
+  // near plane), which on a software renderer saves what shading them would cost.
   FrameStats draw(const RenderSnapshot& snapshot, const Microscope& microscope, int width,
+                  int height, std::span<const PixelRect> covered = {});
+
+  // Flat opaque rectangles of colour `rgba` (no blending, no depth test) over the current
+  // framebuffer's (0, 0, width, height): the trainer's panel backgrounds, which on a software
+  // renderer cost a fraction of ImGui's blended, textured ones.
+  FrameStats fill(std::span<const PixelRect> rects, const std::array<float, 4>& rgba, int width,
                   int height);
 
   RenderOptions& options() { return options_; }

@@ -168,7 +168,7 @@ bool HapticSession::newest_pose(Hand hand, ToolPose& pose) {
     h.pose.pedal = s.pedal;
     h.pose_valid = true;
   }
-  if (!h.pose_valid) return false;  // no sample yet: the track keeps the tool
+  if (!h.pose_valid) return false;  // no sample yet: the scene holds the tool at its start
   pose = h.pose;                    // held while the device is silent: the tool freezes
   return true;
 }

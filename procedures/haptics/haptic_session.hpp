@@ -94,6 +94,7 @@ class HapticSession final : public HapticPort {
   std::vector<DurationHistogram::Bin> period_bins() const { return loop_.period_bins(); }
 
   // HapticPort (simulation thread).
+  bool drives(Hand hand) const override { return hands_[index(hand)].device != nullptr; }
   bool newest_pose(Hand hand, ToolPose& pose) override;
   HapticModel& model_slot() override { return models_.write_slot(); }
   void publish_model() override;

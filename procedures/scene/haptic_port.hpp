@@ -13,8 +13,10 @@ namespace phaco {
 class HapticPort {
  public:
   virtual ~HapticPort() = default;
-  // True when `hand` is driven by a device; `pose` is then its newest sample (held when the
-  // device is silent, so the tool freezes).
+  // True when a device drives `hand` (its track is then not played).
+  virtual bool drives(Hand) const { return false; }
+  // True when `hand`'s device has given a pose; `pose` is then its newest sample (held when the
+  // device is silent, so the tool freezes). False before the first sample and without a device.
   virtual bool newest_pose(Hand hand, ToolPose& pose) = 0;
   virtual HapticModel&
   model_slot() = 0;  // the slot to fill this frame (never read by the haptic thread)

@@ -460,6 +460,41 @@ TEST_F(RendererTest, IndexBuffersAreSentOnlyWhenTopologyChanges) {
   EXPECT_EQ(third.uploads, second.uploads + 1);
 }
 
+// The trainer's panels (issue 24): a covered rectangle is left unshaded (the clear colour) and the
+// rest of the view is drawn as without it; fill() paints flat opaque rectangles.
+TEST_F(RendererTest, ACoveredRectangleIsLeftUnshadedAndFillPaintsIt) {
+  Renderer r(plain());
+  const Image whole = render(r, *eye_);
+  const PixelRect panel{kW / 2.0f - 60, kH / 2.0f - 40, kW / 2.0f + 60, kH / 2.0f + 40};
+  target_->bind();
+  r.draw(*eye_, {}, kW, kH, {&panel, 1});
+  const Image covered{kW, kH, read_pixels(kW, kH)};
+  int inside = 0, unshaded = 0, outside = 0, same = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const bool in = x >= panel.x0 && x < panel.x1 && y >= panel.y0 && y < panel.y1;
+      const uint8_t *a = whole.at(x, y), *b = covered.at(x, y);
+      if (in) {
+        ++inside;
+        unshaded += background(b) ? 1 : 0;
+      } else {
+        ++outside;
+        same += a[0] == b[0] && a[1] == b[1] && a[2] == b[2] ? 1 : 0;
+      }
+    }
+  EXPECT_EQ(unshaded, inside) << "the eye's centre, red reflex and all, is not drawn under it";
+  EXPECT_EQ(same, outside) << "nor is anything else changed";
+  EXPECT_TRUE(red_reflex(whole.at(kW / 2, kH / 2)));
+
+  r.fill({&panel, 1}, {0.0f, 0.0f, 1.0f, 1.0f}, kW, kH);
+  const Image filled{kW, kH, read_pixels(kW, kH)};
+  const uint8_t* c = filled.at(kW / 2, kH / 2);
+  EXPECT_EQ(c[0], 0);
+  EXPECT_EQ(c[2], 255);
+  const uint8_t* below = filled.at(kW / 2, static_cast<int>(panel.y1) + 5);
+  EXPECT_EQ(below[0], covered.at(kW / 2, static_cast<int>(panel.y1) + 5)[0]);
+}
+
 TEST_F(RendererTest, ScreenshotIsAPngOfTheFrame) {
   Renderer r(plain());
   const Image img = render(r, *eye_);

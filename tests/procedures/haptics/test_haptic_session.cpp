@@ -138,6 +138,8 @@ TEST(HapticSession, TheSimulationGetsTheNewestPoseAndASilentDeviceFreezesIt) {
   EXPECT_FALSE(session.newest_pose(Hand::Left, pose))
       << "no device in the left hand: its track drives it";
   EXPECT_FALSE(session.newest_pose(Hand::Right, pose)) << "no sample yet";
+  EXPECT_FALSE(session.drives(Hand::Left));
+  EXPECT_TRUE(session.drives(Hand::Right)) << "before its first sample too: the scene holds it";
   wall_model(session.model_slot(), 1);
   session.publish_model();
   session.start();

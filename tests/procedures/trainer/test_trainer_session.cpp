@@ -229,6 +229,25 @@ TEST(TrainerSession, ARendererHoldingASnapshotHoldsUpNeitherSimulationNorHaptics
   s.stop();
 }
 
+// Issue 24: a hand on the desktop that nobody touches stays where the drill puts it, over the
+// whole recorded track, in the ports as the trainer holds live tools ("constrain").
+TEST(TrainerSession, UntouchedDesktopHandsStayStill) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "real-time drills run in the Release pass";
+#endif
+  TrainerConfig c = config(1.0);
+  c.devices = {"desktop", "desktop"};
+  TrainerSession s(c);
+  s.start();
+  wait_for(s, TrainerState::Ended, 10s);
+  const nlohmann::json r = s.finish();
+  const nlohmann::json& m = r["metrics"];
+  for (const char* hand : {"left", "right"}) {
+    ASSERT_TRUE(m.contains(std::string(hand) + ".path_length_mm")) << hand;
+    EXPECT_LE(m[std::string(hand) + ".path_length_mm"].get<double>(), 0.05) << hand;
+  }
+}
+
 TEST(TrainerSession, BadDeviceSpecsAndFinishBeforeStartAreInputErrors) {
   TrainerConfig c = config(1.0);
   c.devices = {"joystick", "desktop"};
