@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/trainer/trainer_procedure.hpp"
 #include "apps/trainer/trainer_settings.hpp"
 #include "apps/trainer/trainer_soak.hpp"
 #include "apps/trainer/trainer_ui.hpp"
@@ -297,6 +298,12 @@ void start_imgui(GLFWwindow* window, const TrainerOptions& o) {
 
 int run_trainer(const TrainerOptions& o) {
   TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
+  // --procedure: its steps in turn, each on the eye the steps before it left.
+  std::unique_ptr<ProcedureDriver> procedure;
+  if (o.procedure) {
+    procedure = std::make_unique<ProcedureDriver>(*o.procedure, o.procedure_out);
+    config = procedure->step_config(config);
+  }
   // So are bad device specs and trainee names (the session checks them without building anything).
   auto session = std::make_unique<TrainerSession>(config);
   Glfw glfw;
@@ -334,6 +341,16 @@ int run_trainer(const TrainerOptions& o) {
       glfwPollEvents();
       // The Result panel finishes a drill that ended (Idle after), unless this loop got there
       // first (Ended): either way the drill is over.
+      if (procedure && procedure->step_over(*session)) {
+        config = procedure->step_config(config);
+        auto next = std::make_unique<TrainerSession>(config);
+        next->take_unsaved_from(*session);
+        session = std::move(next);
+        session->start();
+        ui = TrainerUi(o, config);  // the next step's panels, its Result not yet shown
+        ui.set_sync(sync.get());
+        continue;
+      }
       if (const TrainerState st = session->state();
           o.soak && (st == TrainerState::Ended || st == TrainerState::Idle)) {
         // A drill ended: sample, then the next drill in a new session, as a station runs.
@@ -395,6 +412,7 @@ int run_trainer(const TrainerOptions& o) {
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
+        if (procedure) procedure->draw_panel();
         if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back(),
                     snap, fb_w, fb_h) == UiAction::Restart) {
           config = ui.config();
@@ -432,8 +450,9 @@ int run_trainer(const TrainerOptions& o) {
     session->stop();
     if (!keep_unsaved(*session, config) && exit_code == 0) exit_code = 2;
   }
-  remember_settings(o,
-                    config);  // an interactive run's choices, for the next (trainer_settings.hpp)
+  if (!procedure)
+    remember_settings(o,
+                      config);  // an interactive run's choices, for the next (trainer_settings.hpp)
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

@@ -180,6 +180,7 @@ void TrainerSession::after_frame(Scene& scene) {
 void TrainerSession::at_end(Scene& scene, const RealtimeRunReport*) {
   end_report_ = to_json(report_of(scene));  // as `phaco run --report`, wall_time_s 0
   end_frames_ = scene.frame;
+  if (config_.at_end) config_.at_end(scene);
 }
 
 void TrainerSession::join() {
