@@ -95,7 +95,9 @@ void ProcedureDriver::write_out() const {
 
 void ProcedureDriver::draw_panel() const {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  ImGui::SetNextWindowPos(ImVec2(10, display.y - 10), ImGuiCond_FirstUseEver, ImVec2(0, 1));
+  // Bottom centre, clear of the Drill, Live, Microscope and History panels.
+  ImGui::SetNextWindowPos(ImVec2(0.5f * display.x, display.y - 10), ImGuiCond_Always,
+                          ImVec2(0.5f, 1.0f));
   ImGui::Begin("Procedure", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::TextUnformatted(procedure_.name.empty() ? procedure_.source.c_str()
                                                  : procedure_.name.c_str());
