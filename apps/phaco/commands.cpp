@@ -59,13 +59,6 @@ SceneOptions scene_options(const Args& a, const std::string& command) {
 
 }  // namespace
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw InputError("cannot write '" + path.string() + "'");
-  out << text;
-  if (!out.flush()) throw InputError("cannot write '" + path.string() + "'");
-}
-
 void print_run(const Args& a, const nlohmann::json& report, const std::string& summary) {
   if (a.flag("--json")) {
     std::printf("%s\n", report.dump(2).c_str());

@@ -1,7 +1,6 @@
 #pragma once
 // The headless `phaco` command: one function per subcommand. Each returns the process exit code:
 // 0 success, 2 bad input (message on stderr), 1 internal error.
-#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -16,9 +15,6 @@ int validate(const std::vector<std::string>& args);
 int mesh(const std::vector<std::string>& args);
 int run(const std::vector<std::string>& args);
 int graph(const std::vector<std::string>& args);
-
-// Writes `text` to `path`; InputError naming the file when it cannot.
-void write_text(const std::filesystem::path& path, const std::string& text);
 
 struct Args;
 // `run`'s output: the JSON report with --json, else the summary and where --report wrote it.
