@@ -294,16 +294,20 @@ void start_imgui(GLFWwindow* window, const TrainerOptions& o) {
   ImGui_ImplOpenGL3_Init("#version 330");
 }
 
+// The next drill (or procedure step) in a new session; drills the database refused stay kept.
+void restart_session(std::unique_ptr<TrainerSession>& session, const TrainerConfig& config) {
+  auto next = std::make_unique<TrainerSession>(config);
+  next->take_unsaved_from(*session);
+  session = std::move(next);
+  session->start();
+}
+
 }  // namespace
 
 int run_trainer(const TrainerOptions& o) {
   TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
   // --procedure: its steps in turn, each on the eye the steps before it left.
-  std::unique_ptr<ProcedureDriver> procedure;
-  if (o.procedure) {
-    procedure = std::make_unique<ProcedureDriver>(*o.procedure, o.procedure_out);
-    config = procedure->step_config(config);
-  }
+  const std::unique_ptr<ProcedureDriver> procedure = start_procedure(o, config);
   // So are bad device specs and trainee names (the session checks them without building anything).
   auto session = std::make_unique<TrainerSession>(config);
   Glfw glfw;
@@ -341,12 +345,10 @@ int run_trainer(const TrainerOptions& o) {
       glfwPollEvents();
       // The Result panel finishes a drill that ended (Idle after), unless this loop got there
       // first (Ended): either way the drill is over.
+      if (procedure && procedure->close_when_done()) break;
       if (procedure && procedure->step_over(*session)) {
         config = procedure->step_config(config);
-        auto next = std::make_unique<TrainerSession>(config);
-        next->take_unsaved_from(*session);
-        session = std::move(next);
-        session->start();
+        restart_session(session, config);
         ui = TrainerUi(o, config);  // the next step's panels, its Result not yet shown
         ui.set_sync(sync.get());
         continue;
@@ -371,10 +373,7 @@ int run_trainer(const TrainerOptions& o) {
         }
         soak_drill = next_soak_drill(soak_drill);
         config.scenario = load_scenario(drill_scenario(soak_drill));
-        auto next = std::make_unique<TrainerSession>(config);
-        next->take_unsaved_from(*session);
-        session = std::move(next);
-        session->start();
+        restart_session(session, config);
         soak_frame0 = frames.ms.size();
         continue;
       }
@@ -416,10 +415,7 @@ int run_trainer(const TrainerOptions& o) {
         if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back(),
                     snap, fb_w, fb_h) == UiAction::Restart) {
           config = ui.config();
-          auto next = std::make_unique<TrainerSession>(config);
-          next->take_unsaved_from(*session);  // drills the database refused stay kept
-          session = std::move(next);
-          session->start();
+          restart_session(session, config);
         }
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -450,9 +446,8 @@ int run_trainer(const TrainerOptions& o) {
     session->stop();
     if (!keep_unsaved(*session, config) && exit_code == 0) exit_code = 2;
   }
-  if (!procedure)
-    remember_settings(o,
-                      config);  // an interactive run's choices, for the next (trainer_settings.hpp)
+  // An interactive drill's choices, for the next (trainer_settings.hpp); not a procedure's step.
+  if (!procedure) remember_settings(o, config);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

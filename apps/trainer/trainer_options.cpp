@@ -34,7 +34,8 @@ usage:
                 data/procedures/cataract_expert.json; its steps (incision, capsulorhexis,
                 sculpting, nucleus removal) follow one another, the incision cut becomes the main
                 port, the torn rhexis the opening, the trench the groove; each step is scored as
-                its drill and the "Procedure" panel shows the step scores and the total
+                its drill and the "Procedure" panel shows the step scores and the total;
+                with every hand scripted (scripted, track, replay:) it closes when done
   --procedure-out  with --procedure: when it is done, write each step's recording, a procedure
                 file over them (replay: phaco run DIR/procedure.json) and the report to DIR
   --difficulty  a level of the drill file (data/drills/<drill>.json: standard, easy, hard, ...)

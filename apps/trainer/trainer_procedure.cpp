@@ -20,8 +20,8 @@ void write_json(const std::filesystem::path& file, const nlohmann::json& j) {
 }  // namespace
 
 ProcedureDriver::ProcedureDriver(const std::filesystem::path& file,
-                                 std::optional<std::filesystem::path> out_dir)
-    : procedure_(load_procedure(file)), out_dir_(std::move(out_dir)) {
+                                 std::optional<std::filesystem::path> out_dir, bool scripted)
+    : procedure_(load_procedure(file)), out_dir_(std::move(out_dir)), scripted_(scripted) {
   state_ = begin_procedure(procedure_);
 }
 
@@ -121,6 +121,17 @@ void ProcedureDriver::draw_panel() const {
       ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.3f, 1.0f), "FAILED: %s", r.failure.c_str());
   }
   ImGui::End();
+}
+
+std::unique_ptr<ProcedureDriver> start_procedure(const TrainerOptions& o, TrainerConfig& config) {
+  if (!o.procedure) return nullptr;
+  const auto scripted = [](const std::string& d) {
+    return d == "scripted" || d == "track" || d.rfind("replay:", 0) == 0;
+  };
+  auto driver = std::make_unique<ProcedureDriver>(*o.procedure, o.procedure_out,
+                                                  scripted(o.left) && scripted(o.right));
+  config = driver->step_config(config);
+  return driver;
 }
 
 }  // namespace phaco::trainer

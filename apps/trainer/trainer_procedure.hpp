@@ -5,10 +5,12 @@
 // "Procedure" panel and on stdout. With --procedure-out DIR, each step's recording, a procedure
 // file over them (`phaco run DIR/procedure.json` replays it) and the procedure's report go there.
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <vector>
 
+#include "apps/trainer/trainer_options.hpp"
 #include "procedures/procedure/procedure_run.hpp"
 #include "procedures/trainer/trainer_session.hpp"
 
@@ -16,7 +18,9 @@ namespace phaco::trainer {
 
 class ProcedureDriver {
  public:
-  ProcedureDriver(const std::filesystem::path& file, std::optional<std::filesystem::path> out_dir);
+  // scripted: every hand plays a script (close_when_done).
+  ProcedureDriver(const std::filesystem::path& file, std::optional<std::filesystem::path> out_dir,
+                  bool scripted);
   ProcedureDriver(const ProcedureDriver&) = delete;  // the sessions' hooks point here
   ProcedureDriver& operator=(const ProcedureDriver&) = delete;
 
@@ -27,6 +31,9 @@ class ProcedureDriver {
   // it), scores the step and carries the eye on; true when the next step is to start.
   bool step_over(TrainerSession& session);
   bool done() const { return procedure_done(state_); }
+  // Done, and every hand played a script (scripted, track, replay): the trainer closes, as an
+  // unattended run does; a trainee's window stays open on the Procedure panel.
+  bool close_when_done() const { return done() && scripted_; }
   void draw_panel() const;  // between ImGui::NewFrame and ImGui::Render
 
  private:
@@ -39,6 +46,10 @@ class ProcedureDriver {
   std::optional<ProcedureState> pending_;  // the last live run's end (simulation thread)
   const TrainerSession* taken_ = nullptr;  // the session whose end was taken
   std::vector<Scenario> recordings_;       // the steps as the trainee did them
+  bool scripted_ = false;                  // every hand plays a script
 };
+
+// --procedure's driver, with `config` set to its first step; null without --procedure.
+std::unique_ptr<ProcedureDriver> start_procedure(const TrainerOptions& o, TrainerConfig& config);
 
 }  // namespace phaco::trainer
