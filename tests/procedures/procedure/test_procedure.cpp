@@ -16,6 +16,7 @@
 #include "procedures/procedure/procedure_run.hpp"
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/tool_ports.hpp"
+#include "procedures/trainer/live_ports.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
@@ -119,6 +120,10 @@ TEST(Procedure, TheMainPortIsTheIncisionThatWasCut) {
     EXPECT_NEAR(main.width_mm, eye::default_eye_params().get("tools.keratome_width_mm"), 0.3);
     EXPECT_GT(main.tunnel_length_mm, 1.0);
     EXPECT_GT(main.axis.dot(-main.centre_mm.normalized()), 0.5) << "the tunnel runs inward";
+    // The trainer's mouse pivots the right hand's shaft in that same port.
+    const auto pivots = desktop_ports(rhexis->scenario, &state.carried);
+    ASSERT_TRUE(pivots[static_cast<size_t>(Hand::Right)]);
+    EXPECT_EQ(pivots[static_cast<size_t>(Hand::Right)]->centre_mm, cut.centre_mm);
   }
 }
 
