@@ -31,7 +31,8 @@ TrainerConfig ProcedureDriver::step_config(const TrainerConfig& base) {
   c.scene.carried = &state_.carried;
   // The simulation thread, at the live run's end: score the step and carry its eye on a copy;
   // step_over takes it once the session is over (a restarted run's end is replaced by the next).
-  c.at_end = [this](Scene& scene) {
+  c.at_end = [this, drill = c.scenario.drill](Scene& scene) {
+    if (scene.scenario.drill != drill) return;  // another drill chosen in the Drill panel
     std::unique_lock lock(mutex_);
     ProcedureState next = state_;
     lock.unlock();
@@ -53,7 +54,7 @@ bool ProcedureDriver::step_over(TrainerSession& session) {
   taken_ = &session;
   {
     std::lock_guard lock(mutex_);
-    if (!pending_) throw InputError("procedure: the step ended without its scene's end state");
+    if (!pending_) return false;  // not the step's drill (the Drill panel started another)
     state_ = std::move(*pending_);
     pending_.reset();
     // The step took the live run's wall time, pauses left out.
