@@ -118,8 +118,11 @@ void ProcedureDriver::draw_panel() const {
   if (done()) {
     ImGui::Separator();
     ImGui::Text("total %.1f / 100", r.total);
-    if (r.failed)
+    if (r.failed) {
+      ImGui::PushTextWrapPos(ImGui::GetFontSize() * 28.0f);  // a long reason wraps
       ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.3f, 1.0f), "FAILED: %s", r.failure.c_str());
+      ImGui::PopTextWrapPos();
+    }
   }
   ImGui::End();
 }
