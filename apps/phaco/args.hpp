@@ -3,6 +3,8 @@
 // everything else positional. Unknown options are bad input (exit code 2), named in the message.
 // (A copy of the helper in commands.cpp, made shareable for records_commands.cpp.)
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <utility>
@@ -27,6 +29,14 @@ struct Args {
     return std::find(flags.begin(), flags.end(), name) != flags.end();
   }
 };
+
+// Writes `text` to `path`; InputError naming the file when it cannot.
+inline void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw InputError("cannot write '" + path.string() + "'");
+  out << text;
+  if (!out.flush()) throw InputError("cannot write '" + path.string() + "'");
+}
 
 inline Args parse_args(const std::string& command, const std::vector<std::string>& raw,
                        const std::vector<std::string>& valued,

@@ -9,6 +9,7 @@
 
 #include "apps/phaco/args.hpp"
 #include "apps/phaco/haptic_record.hpp"
+#include "apps/phaco/procedure_command.hpp"
 #include "apps/phaco/records_commands.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
@@ -19,6 +20,7 @@
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/eye/mesh_cache.hpp"
 #include "procedures/haptics/realtime_run.hpp"
+#include "procedures/procedure/procedure_file.hpp"
 #include "procedures/scene/run.hpp"
 #include "procedures/scene/scene_inputs.hpp"
 
@@ -48,13 +50,6 @@ double parse_seconds(const std::string& command, const std::string& option, cons
   return value;
 }
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw InputError("cannot write '" + path.string() + "'");
-  out << text;
-  if (!out.flush()) throw InputError("cannot write '" + path.string() + "'");
-}
-
 SceneOptions scene_options(const Args& a, const std::string& command) {
   SceneOptions o;
   if (auto t = a.option("--threads")) o.threads = parse_int(command, "--threads", *t, 1, 256);
@@ -64,12 +59,25 @@ SceneOptions scene_options(const Args& a, const std::string& command) {
 
 }  // namespace
 
+void print_run(const Args& a, const nlohmann::json& report, const std::string& summary) {
+  if (a.flag("--json")) {
+    std::printf("%s\n", report.dump(2).c_str());
+  } else {
+    std::fputs(summary.c_str(), stdout);
+    if (auto path = a.option("--report")) std::printf("report written to %s\n", path->c_str());
+  }
+}
+
 int validate(const std::vector<std::string>& raw) {
   const Args a = parse_args("validate", raw, {}, {});
   if (a.positional.empty()) throw InputError("validate: give one or more scenario files");
   int status = kOk;
   for (const auto& file : a.positional) {
     try {
+      if (is_procedure_file(file)) {
+        validate_procedure_file(file);
+        continue;
+      }
       const Scenario s = load_scenario(file);
       // The drill file, the difficulty and the eye parameters, as `run` reads them before meshes.
       check_scene_inputs(s);
@@ -201,6 +209,8 @@ int run(const std::vector<std::string>& raw) {
                   "--stall-at", "--stall-ms", "--spin-us", "--record", "--trainee", "--difficulty"},
                  {"--json", "--no-rt"});
   if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
+  if (is_procedure_file(a.positional[0]))
+    return run_procedure_file(a, scene_options(a, "run"));  // docs/procedures.md
   Scenario scenario = load_scenario(a.positional[0]);
   // A level of the drill file (docs/drills.md); checked when the scene is built.
   if (auto level = a.option("--difficulty")) scenario.difficulty = *level;
@@ -226,12 +236,7 @@ int run(const std::vector<std::string>& raw) {
     std::fprintf(stderr, "recorded as record %lld in %s\n", static_cast<long long>(id),
                  shown_location(db->string()).c_str());
   }
-  if (a.flag("--json")) {
-    std::printf("%s\n", j.dump(2).c_str());
-  } else {
-    std::fputs(summary_text(report).c_str(), stdout);
-    if (auto path = a.option("--report")) std::printf("report written to %s\n", path->c_str());
-  }
+  print_run(a, j, summary_text(report));
   return kOk;
 }
 

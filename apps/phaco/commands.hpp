@@ -1,6 +1,7 @@
 #pragma once
 // The headless `phaco` command: one function per subcommand. Each returns the process exit code:
 // 0 success, 2 bad input (message on stderr), 1 internal error.
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -14,5 +15,9 @@ int validate(const std::vector<std::string>& args);
 int mesh(const std::vector<std::string>& args);
 int run(const std::vector<std::string>& args);
 int graph(const std::vector<std::string>& args);
+
+struct Args;
+// `run`'s output: the JSON report with --json, else the summary and where --report wrote it.
+void print_run(const Args& a, const nlohmann::json& report, const std::string& summary);
 
 }  // namespace phaco::cli

@@ -28,6 +28,11 @@ usage:
       Any DB may be an SQLite file or a postgresql:// URI (a training centre's server).
       --difficulty picks a level of the drill file (drills/<drill>.json in the data folder,
       e.g. standard, easy, hard; docs/drills.md) instead of the scenario's.
+  phaco run PROCEDURE.json [--threads N] [--report OUT.json] [--json] [--difficulty LEVEL]
+      A procedure (a file with "steps", e.g. procedures/cataract_expert.json in the data folder;
+      docs/procedures.md): its drills one after the other in one eye (the incision cut is the
+      main port, the torn rhexis the opening, the sculpted trench the groove), each scored as its
+      drill, and the total; a complication fails the procedure there and says why.
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
                  [--record DB --trainee NAME]
@@ -43,9 +48,10 @@ usage:
       --stall-at/--stall-ms make the simulation hang once, to show the force stays continuous.
       --record stores the scenario with the track the device produced (docs/records.md).
   phaco validate FILE...
-      Check scenario files and what they use (the drill file, its difficulty level, the eye
-      parameters and overrides, each within its range; docs/scenario_format.md); every problem is
-      named by file, JSON path and what was expected. A file validate accepts runs to its end.
+      Check scenario (and procedure) files and what they use (the drill file, its difficulty
+      level, the eye parameters and overrides, each within its range; docs/scenario_format.md);
+      every problem is named by file, JSON path and what was expected. A file validate accepts
+      runs to its end.
   phaco mesh --level L --out DIR [--layout curvilinear|isotropic] [--no-tets] [--params FILE]
       Generate the standard eye's meshes at resolution level L (0..8, default eye level 3:
       about 8k capsule vertices, 50k lens tets) as OBJ and TetGen .node/.ele files.
@@ -53,11 +59,12 @@ usage:
       Write a run report (phaco run --report) as one self-contained HTML page: the score and its
       terms, every metric against its target, the events, and plots (force, speed, paths, the
       rhexis against its target circle, the trench from above) (docs/report.md); --expert adds
-      the comparison with an expert's run report.
+      the comparison with an expert's run report. A procedure's report: the total, the steps'
+      table and each step's page.
   phaco compare RUN.json EXPERT.json [--json OUT.json]
       Compare a run report with an expert's: per hand, path distance, speed and force differences
       after dynamic time warping of the tool paths, the time ratio, and run - expert per metric
-      (docs/compare.md).
+      (docs/compare.md). Two procedures' reports are compared step by step.
   phaco sync --to URI [--db FILE] [--all] [--batch N] [--json]
       Upload this station's records (its SQLite file, --db or the default) to a training
       centre's PostgreSQL server (URI postgresql://USER[:PASSWORD]@HOST[:PORT]/DB, or

@@ -63,13 +63,6 @@ std::string show_date(const std::string& utc) {
   return d;
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw InputError("cannot write '" + path.string() + "'");
-  out << text;
-  if (!out.flush()) throw InputError("cannot write '" + path.string() + "'");
-}
-
 fs::path db_path(const Args& a) {
   if (auto db = a.option("--db")) return *db;
   return default_records_db();

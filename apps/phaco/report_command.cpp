@@ -11,6 +11,7 @@
 #include "engine/core/error.hpp"
 #include "procedures/report/compare_section.hpp"
 #include "procedures/report/html_report.hpp"
+#include "procedures/report/procedure_html.hpp"
 
 namespace phaco::cli {
 
@@ -64,13 +65,18 @@ int report(const std::vector<std::string>& args) {
   if (run.is_object() && !run.contains("date")) {
     if (const std::string d = file_date(in); !d.empty()) run["date"] = d;
   }
+  if (report::is_procedure_report(run) && !expert.empty())
+    throw InputError("report: --expert compares a drill's run; " + in +
+                     " is a procedure's (compare its steps: docs/procedures.md)");
   // Compared before the page is drawn, so a bad expert file fails with its own name.
   const std::string compared = expert.empty() ? std::string()
                                               : report::compare_section(compare::compare_reports(
                                                     run, compare::read_report(expert), in, expert));
   std::string html;
   try {
-    html = report::html_report(run, compared);
+    // A procedure's report: its steps' pages under the total (docs/procedures.md).
+    html = report::is_procedure_report(run) ? report::procedure_html(run)
+                                            : report::html_report(run, compared);
   } catch (const InputError& e) {
     throw InputError(in + ": " + e.what());
   }

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/trainer/trainer_procedure.hpp"
 #include "apps/trainer/trainer_settings.hpp"
 #include "apps/trainer/trainer_soak.hpp"
 #include "apps/trainer/trainer_ui.hpp"
@@ -360,10 +361,20 @@ std::array<float, 4> start_imgui(GLFWwindow* window, const TrainerOptions& o) {
   return {bg.x, bg.y, bg.z, 1.0f};
 }
 
+// The next drill (or procedure step) in a new session; drills the database refused stay kept.
+void restart_session(std::unique_ptr<TrainerSession>& session, const TrainerConfig& config) {
+  auto next = std::make_unique<TrainerSession>(config);
+  next->take_unsaved_from(*session);
+  session = std::move(next);
+  session->start();
+}
+
 }  // namespace
 
 int run_trainer(const TrainerOptions& o) {
   TrainerConfig config = config_of(o);  // bad scenario / level: InputError before any window
+  // --procedure: its steps in turn, each on the eye the steps before it left.
+  const std::unique_ptr<ProcedureDriver> procedure = start_procedure(o, config);
   // So are bad device specs and trainee names (the session checks them without building anything).
   auto session = std::make_unique<TrainerSession>(config);
   Glfw glfw;
@@ -402,6 +413,14 @@ int run_trainer(const TrainerOptions& o) {
       glfwPollEvents();
       // The Result panel finishes a drill that ended (Idle after), unless this loop got there
       // first (Ended): either way the drill is over.
+      if (procedure && procedure->close_when_done()) break;
+      if (procedure && procedure->step_over(*session)) {
+        config = procedure->step_config(config);
+        restart_session(session, config);
+        ui = TrainerUi(o, config);  // the next step's panels, its Result not yet shown
+        ui.set_sync(sync.get());
+        continue;
+      }
       if (const TrainerState st = session->state();
           o.soak && (st == TrainerState::Ended || st == TrainerState::Idle)) {
         // A drill ended: sample, then the next drill in a new session, as a station runs.
@@ -422,10 +441,7 @@ int run_trainer(const TrainerOptions& o) {
         }
         soak_drill = next_soak_drill(soak_drill);
         config.scenario = load_scenario(drill_scenario(soak_drill));
-        auto next = std::make_unique<TrainerSession>(config);
-        next->take_unsaved_from(*session);
-        session = std::move(next);
-        session->start();
+        restart_session(session, config);
         soak_frame0 = frames.ms.size();
         continue;
       }
@@ -467,13 +483,11 @@ int run_trainer(const TrainerOptions& o) {
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
+        if (procedure) procedure->draw_panel();
         if (ui.draw(*session, renderer, microscope, frames.ms.empty() ? 0.0 : frames.ms.back(),
                     snap, fb_w, fb_h) == UiAction::Restart) {
           config = ui.config();
-          auto next = std::make_unique<TrainerSession>(config);
-          next->take_unsaved_from(*session);  // drills the database refused stay kept
-          session = std::move(next);
-          session->start();
+          restart_session(session, config);
         }
         ImGui::Render();
         render_panels(renderer, panel_bg, fb_w, fb_h);
@@ -504,8 +518,8 @@ int run_trainer(const TrainerOptions& o) {
     session->stop();
     if (!keep_unsaved(*session, config) && exit_code == 0) exit_code = 2;
   }
-  remember_settings(o,
-                    config);  // an interactive run's choices, for the next (trainer_settings.hpp)
+  // An interactive drill's choices, for the next (trainer_settings.hpp); not a procedure's step.
+  if (!procedure) remember_settings(o, config);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

@@ -24,11 +24,20 @@ usage:
   phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
   phaco-trainer ... --soak OUT.json [--soak-for SECONDS]
   phaco-trainer ... --ui-state OUT.json
+  phaco-trainer --procedure FILE [--procedure-out DIR] [--left DEVICE] [--right DEVICE] ...
   phaco-trainer --help | --version
 
   --drill       corneal_incision | capsulorhexis | phaco_sculpting | nucleus_removal (default
                 capsulorhexis); the tools start where the drill's expert scenario starts them
   --scenario    any scenario file instead (its tracks give the tools and start poses)
+  --procedure   the whole operation in one eye (docs/procedures.md): a procedure file, e.g.
+                data/procedures/cataract_expert.json; its steps (incision, capsulorhexis,
+                sculpting, nucleus removal) follow one another, the incision cut becomes the main
+                port, the torn rhexis the opening, the trench the groove; each step is scored as
+                its drill and the "Procedure" panel shows the step scores and the total;
+                with every hand scripted (scripted, track, replay:) it closes when done
+  --procedure-out  with --procedure: when it is done, write each step's recording, a procedure
+                file over them (replay: phaco run DIR/procedure.json) and the report to DIR
   --difficulty  a level of the drill file (data/drills/<drill>.json: standard, easy, hard, ...)
   --left/--right  the hand's device: desktop (mouse, keyboard, gamepad; default), scripted (the
                 scenario's track in real time through the 1 kHz loop), track (the scene plays the
@@ -101,10 +110,10 @@ std::filesystem::path drill_scenario(const std::string& drill) {
 TrainerOptions parse_options(const std::vector<std::string>& raw) {
   const cli::Args a = cli::parse_args(
       "command line", raw,
-      {"--drill",     "--scenario",   "--difficulty", "--left",     "--right",
-       "--trainee",   "--db",         "--sync-to",    "--size",     "--threads",
-       "--cache-dir", "--screenshot", "--after",      "--stats",    "--stats-after",
-       "--duration",  "--timeout",    "--soak",       "--soak-for", "--ui-state"},
+      {"--drill",    "--scenario", "--difficulty",  "--left",         "--right",     "--trainee",
+       "--db",       "--sync-to",  "--size",        "--threads",      "--cache-dir", "--screenshot",
+       "--after",    "--stats",    "--stats-after", "--duration",     "--timeout",   "--soak",
+       "--soak-for", "--ui-state", "--procedure",   "--procedure-out"},
       {"--stereo", "--no-guidance", "--no-ui", "--no-render"}, "phaco-trainer --help");
   if (!a.positional.empty()) {
     throw InputError("unexpected argument '" + a.positional[0] +
@@ -168,6 +177,15 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   if (auto v = a.option("--soak-for")) {
     if (!o.soak) throw InputError("--soak-for: only with --soak");
     o.soak_for_s = number("--soak-for", *v, 5, 86400);
+  }
+  if (auto v = a.option("--procedure")) {
+    if (a.option("--drill") || a.option("--scenario") || o.soak)
+      throw InputError("--procedure: not with --drill, --scenario or --soak (its steps say)");
+    o.procedure = *v;
+  }
+  if (auto v = a.option("--procedure-out")) {
+    if (!o.procedure) throw InputError("--procedure-out: only with --procedure");
+    o.procedure_out = *v;
   }
   // A soak gives up only well after its own length (the drill in progress ends first).
   if (o.soak && !a.option("--timeout")) o.timeout_s = o.soak_for_s + 600;

@@ -39,6 +39,9 @@ struct TrainerOptions {
   // What the trainee sees (TrainerUi::state_json), rewritten ten times a second while running.
   std::optional<std::filesystem::path> ui_state;
   double soak_for_s = 60.0;
+  // The procedure mode (apps/trainer/trainer_procedure.hpp): the procedure file, and where its
+  // recording and report go when it is done.
+  std::optional<std::filesystem::path> procedure, procedure_out;
 };
 
 extern const char* const kUsage;

@@ -6,11 +6,9 @@
 
 namespace phaco::rhexis {
 
-Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm) {
-  Opening out;
+std::vector<uint8_t> held_triangles(const cut::CutMesh& m) {
   const Triangles& tr = m.triangles;
   const uint32_t nt = tr.slots.size();
-  // Triangles connected (across joined edges) to one with an anchored corner: the held capsule.
   std::vector<uint8_t> held(nt, 0);
   std::vector<uint32_t> queue;
   for (uint32_t t = 0; t < nt; ++t) {
@@ -24,6 +22,14 @@ Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm)
       if (n != kInvalidIndex && tr.slots.alive(n) && !held[n]) held[n] = 1, queue.push_back(n);
     }
   }
+  return held;
+}
+
+Opening measure_opening(const cut::CutMesh& m, double pixel_mm, double field_mm) {
+  Opening out;
+  const Triangles& tr = m.triangles;
+  const uint32_t nt = tr.slots.size();
+  const std::vector<uint8_t> held = held_triangles(m);
 
   const int size = static_cast<int>(std::ceil(2.0 * field_mm / pixel_mm));
   cv::Mat covered(size, size, CV_8UC1, cv::Scalar(0));

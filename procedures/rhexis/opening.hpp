@@ -34,6 +34,10 @@ struct Opening {
   std::vector<std::array<double, 2>> outline_mm;
 };
 
+// Per triangle slot: 1 if it is alive and connected (across joined edges) to a triangle with an
+// anchored corner — the capsule still held at its rim; the torn-off disc is 0.
+std::vector<uint8_t> held_triangles(const cut::CutMesh& mesh);
+
 // pixel_mm: raster resolution; field_mm: half-width of the square field around the axis.
 Opening measure_opening(const cut::CutMesh& mesh, double pixel_mm = 0.01, double field_mm = 5.0);
 

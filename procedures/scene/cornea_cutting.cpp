@@ -165,6 +165,8 @@ bool measure_scene_incision(Scene& scene, MeshIncision& out) {
       corneal_incision::tool_polyline(cc->inner));
   out.outer_cut = outer.exists;
   out.inner_cut = inner.exists;
+  out.outer_middle = outer.middle;
+  out.inner_middle = inner.middle;
   if (outer.exists) {
     const Vec3& c = outer.middle;
     out.width_mm = outer.chord_mm;

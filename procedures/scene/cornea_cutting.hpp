@@ -89,6 +89,8 @@ struct MeshIncision {
   double entry_angle_deg = 0;       // below the anterior surface's tangent plane
   double iris_plane_angle_deg = 0;  // below the iris plane (IncisionResult::mesh_entry_angle_deg)
   double tunnel_length_mm = 0;
+  // The middles of the outer and inner cuts (mm): the tunnel runs from one to the other.
+  Vec3 outer_middle = Vec3::Zero(), inner_middle = Vec3::Zero();
   CornealWound wound;  // the tracker's (section-based) measures
 };
 bool measure_scene_incision(Scene& scene, MeshIncision& out);

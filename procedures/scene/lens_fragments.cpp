@@ -71,7 +71,14 @@ void groove(Scene& scene, LensFragments& lf, Tets& tets) {
   g.nucleus_anterior_mm = f * p.get("lens.anterior_half_thickness_mm");
   g.nucleus_posterior_mm = f * p.get("lens.posterior_half_thickness_mm");
   lens::FragmentLens& l = lf.lens;
-  const std::vector<uint32_t> cells = lens::groove_cells(l.cells, g);
+  // In a procedure the groove is the trench the sculpting step cut (its tets are the cells).
+  std::vector<uint32_t> cells;
+  if (const auto& carried = scene.carried.lens_removed) {
+    for (uint32_t c : *carried)
+      if (c < l.cells.size() && l.cells.alive[c]) cells.push_back(c);
+  } else {
+    cells = lens::groove_cells(l.cells, g);
+  }
   for (uint32_t c : cells) l.grooved_mass_kg += l.cells.mass[c];
   lens::FragmentLensStats st;
   lens::remove_lens_cells(l, cells, st);
@@ -112,7 +119,8 @@ void add_lens_fragments(Scene& scene) {
   s.bounds = lens_tools::eye_bounds(a, params.get("lens.anterior_half_thickness_mm"),
                                     -params.get("lens.posterior_half_thickness_mm"),
                                     params.get("cornea.posterior_apex_z_mm"),
-                                    params.get("cornea.posterior_radius_mm"), kRhexisRadiusMm, fit);
+                                    params.get("cornea.posterior_radius_mm"),
+                                    scene.carried.rhexis_radius_mm.value_or(kRhexisRadiusMm), fit);
   s.nucleus_hardness = std::min(1.0, params.get("lens_model.nucleus_hardness"));
   s.density_kg_mm3 = params.get("lens.density_kg_m3") * kKgPerMm3PerKgPerM3;
   double volume = 0;

@@ -130,10 +130,29 @@ Tets make_tets(const TetMesh& mesh) {
   return t;
 }
 
+// A membrane an earlier step of the procedure left (carried_state.hpp), as it stood.
+void add_carried_surface(Scene& scene, Entity e, const CarriedSurface& s) {
+  Particles particles = particles_at(s.vertices, ParticleKind::Anchored, 0.0f);
+  particles.kind = s.kind;
+  particles.inv_mass = s.inv_mass;
+  SurfaceMesh mesh;
+  mesh.triangles = s.triangles;
+  scene.world.add(e, std::move(particles));
+  scene.world.add(e, triangles_of(mesh));
+}
+
+const CarriedSurface* carried_surface(const Scene& scene, BodyPart part) {
+  if (part == BodyPart::Cornea && scene.carried.cornea) return &*scene.carried.cornea;
+  if (part == BodyPart::Capsule && scene.carried.capsule) return &*scene.carried.capsule;
+  return nullptr;
+}
+
 void add_body(Scene& scene, BodyPart part, const eye::EyeMeshes& meshes) {
   const Entity e = scene.world.create(EntityKind::Body, std::string(to_string(part)));
   scene.world.add(e, Body{part});
-  if (part == BodyPart::Lens) {
+  if (const CarriedSurface* carried = carried_surface(scene, part)) {
+    add_carried_surface(scene, e, *carried);
+  } else if (part == BodyPart::Lens) {
     scene.world.add(e, particles_at(meshes.lens_tets->vertices, ParticleKind::Anchored, 0.0f));
     scene.world.add(e, make_tets(*meshes.lens_tets));
   } else {
@@ -337,6 +356,7 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
   scene->resolution = eye::resolution_for_level(scenario.eye.level);
   scene->commands = CommandQueues(options.threads);
   scene->haptics = options.haptics;
+  if (options.carried) scene->carried = *options.carried;
 
   std::vector<BodyPart> parts;
   for (const std::string& name : scene->drill.bodies) parts.push_back(body_part(name));

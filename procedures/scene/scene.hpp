@@ -26,6 +26,7 @@
 #include "engine/schedule/frame_graph.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/eye/resolution.hpp"
+#include "procedures/scene/carried_state.hpp"
 #include "procedures/scene/haptic_port.hpp"
 
 namespace phaco {
@@ -45,6 +46,9 @@ struct SceneOptions {
   AccessCheck access_check = AccessCheck::BuildDefault;
   // How frames reach the threads (engine/schedule/executor.hpp); Auto unless a study compares.
   Dispatch dispatch = Dispatch::Auto;
+  // A procedure's earlier steps (procedures/procedure): the eye as they left it, instead of the
+  // drill's fresh eye. Null: the drill's own start state.
+  const CarriedState* carried = nullptr;
 };
 
 struct Scene {
@@ -63,6 +67,7 @@ struct Scene {
   double time_s = 0;
   double mesh_load_s = 0;         // wall time to load or build the meshes
   HapticPort* haptics = nullptr;  // from SceneOptions
+  CarriedState carried;           // from SceneOptions (empty: the drill's start state)
 
   std::optional<Entity> body(BodyPart part) const;
 };

@@ -112,6 +112,8 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
   } catch (const InputError& e) {
     throw InputError(scene.scenario.source + ": eye: " + e.what());
   }
+  // In a procedure the main port is the incision the trainee cut (procedures/procedure/carry).
+  if (scene.carried.main_port) r.ports.front() = *scene.carried.main_port;
   r.eye = tool_eye_shape(scene.params);
   r.stiffness = tool_eye_stiffness(scene.params);
   r.constrain = mode == "constrain";

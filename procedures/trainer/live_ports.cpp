@@ -22,14 +22,16 @@ Scenario with_live_ports(const Scenario& s, const std::array<std::string, 2>& de
   return out;
 }
 
-std::array<std::optional<EyePort>, 2> desktop_ports(const Scenario& running) {
+std::array<std::optional<EyePort>, 2> desktop_ports(const Scenario& running,
+                                                    const CarriedState* carried) {
   std::array<std::optional<EyePort>, 2> out;
   const SceneInputs in = check_scene_inputs(running);
   const Guidance& g = in.drill.guidance;
   if (method_value(running, "tools.ports", in.drill.ports) == "off" || !g.incision_site ||
       !g.side_port)
     return out;
-  const auto ports = default_ports(in.params, g.incision_site->clock_hour, g.side_port->clock_hour);
+  auto ports = default_ports(in.params, g.incision_site->clock_hour, g.side_port->clock_hour);
+  if (carried && carried->main_port) ports.front() = *carried->main_port;
   for (Hand h : {Hand::Left, Hand::Right}) {
     const HandTrack* t = running.find_hand(h);
     if (!t || t->tool == ToolKind::Keratome) continue;

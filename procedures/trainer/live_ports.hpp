@@ -17,6 +17,7 @@
 
 #include "components/eye_ports.hpp"
 #include "engine/io/scenario.hpp"
+#include "procedures/scene/carried_state.hpp"
 
 namespace phaco {
 
@@ -29,7 +30,9 @@ Scenario with_live_ports(const Scenario& s, const std::array<std::string, 2>& de
 
 // The port each hand's desktop input pivots in, indexed as Hand: main for the right hand, side for
 // the left (the scripted drills' convention); none for a keratome (it cuts its port), a hand
-// without a track, or when the ports are off.
-std::array<std::optional<EyePort>, 2> desktop_ports(const Scenario& running);
+// without a track, or when the ports are off. In a procedure (`carried`), the main port is the
+// incision that was cut, as the scene's (procedures/scene/tool_ports).
+std::array<std::optional<EyePort>, 2> desktop_ports(const Scenario& running,
+                                                    const CarriedState* carried = nullptr);
 
 }  // namespace phaco

@@ -63,7 +63,7 @@ void TrainerSession::launch(const Scenario& scenario, const std::array<std::stri
   // Live inputs hold their tools in the ports (procedures/trainer/live_ports.hpp).
   running_scenario_ = with_live_ports(scenario, devices);
   running_devices_ = devices;
-  const auto pivots = desktop_ports(running_scenario_);
+  const auto pivots = desktop_ports(running_scenario_, config_.scene.carried);
   if (!config_.trainee.empty()) {
     // Fail before the drill, not after it: the database opens and the name is acceptable.
     check_record_target(config_.records_db.empty() ? default_records_db() : config_.records_db,
@@ -180,6 +180,7 @@ void TrainerSession::after_frame(Scene& scene) {
 void TrainerSession::at_end(Scene& scene, const RealtimeRunReport*) {
   end_report_ = to_json(report_of(scene));  // as `phaco run --report`, wall_time_s 0
   end_frames_ = scene.frame;
+  if (config_.at_end) config_.at_end(scene);
 }
 
 void TrainerSession::join() {

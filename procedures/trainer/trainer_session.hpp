@@ -22,6 +22,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -52,6 +53,9 @@ struct TrainerConfig {
   // default, default_records_db() of engine/records/record_run.hpp).
   std::string trainee;
   std::filesystem::path records_db;
+  // Called on the simulation thread with the scene at the end of each live run (the procedure
+  // mode takes the eye it leaves from there: apps/trainer/trainer_procedure.hpp); may be empty.
+  std::function<void(Scene&)> at_end;
 };
 
 enum class TrainerState : uint8_t {

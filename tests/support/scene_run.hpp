@@ -32,4 +32,19 @@ inline std::unique_ptr<Scene> run_to_end(const Scenario& s, int threads) {
   return scene;
 }
 
+// The sculpting probe enters through its port, then plunges with ultrasound on through the whole
+// lens to 0.3 mm beyond its posterior pole (a posterior capsule rupture), over 2 s.
+inline void plunge_through_posterior_capsule(Scenario& s, double posterior_pole_mm) {
+  const Quat q = Quat(0.719345, -0.075527, 0.690535, 0.0).normalized();
+  const double z = -(posterior_pole_mm + 0.3);
+  for (HandTrack& h : s.hands) {
+    if (h.tool != ToolKind::PhacoProbe) continue;
+    h.track = {{0.0, Vec3(5.26, 0.0, 2.35), q, 0, 0},
+               {0.5, Vec3(2.3, -0.35, 2.3), q, 0, 1},
+               {1.5, Vec3(0.3, 0.0, z), q, 0, 3},
+               {2.0, Vec3(0.3, 0.0, z), q, 0, 3}};
+  }
+  s.duration_s = 2.0;
+}
+
 }  // namespace phaco::test

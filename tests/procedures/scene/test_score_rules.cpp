@@ -59,16 +59,8 @@ TEST(ScoreRules, IdleToolsScoreZeroInEveryDrill) {
 // 0.3 mm beyond its posterior pole.
 TEST(ScoreRules, APlungeThroughThePosteriorCapsuleFailsSculpting) {
   Scenario s = test::repo_scenario("phaco_sculpting_expert.json");
-  const double posterior = eye::default_eye_params().get("lens.posterior_half_thickness_mm") + 0.3;
-  const Quat q = Quat(0.719345, -0.075527, 0.690535, 0.0).normalized();
-  for (HandTrack& h : s.hands) {
-    if (h.tool != ToolKind::PhacoProbe) continue;
-    h.track = {{0.0, Vec3(5.26, 0.0, 2.35), q, 0, 0},
-               {0.5, Vec3(2.3, -0.35, 2.3), q, 0, 1},
-               {1.5, Vec3(0.3, 0.0, -posterior), q, 0, 3},
-               {2.0, Vec3(0.3, 0.0, -posterior), q, 0, 3}};
-  }
-  s.duration_s = 2.0;
+  test::plunge_through_posterior_capsule(
+      s, eye::default_eye_params().get("lens.posterior_half_thickness_mm"));
   const RunReport r = run(s);
   EXPECT_EQ(r.metrics.value("capsule_breach", 0.0), 1.0);
   ASSERT_EQ(r.complications.size(), 1u);
