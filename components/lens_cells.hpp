@@ -10,6 +10,8 @@
 #include <span>
 #include <vector>
 
+#include "engine/core/invariants.hpp"
+
 namespace phaco {
 
 struct LensCells {
@@ -41,6 +43,9 @@ struct CellSpans {
   std::span<const float> hardness;  // 0..1
 
   uint32_t size() const { return static_cast<uint32_t>(x.size()); }
+  // Every column of one length: the lens tools assert it in debug builds (a view made of columns
+  // of two tables would be read past the shorter one's end).
+  bool in_step() const { return same_size(x, y, z, vx, vy, vz, mass, alive, hardness); }
 };
 
 inline CellSpans cell_spans(LensCells& c) {

@@ -1,5 +1,7 @@
 #include "engine/core/table.hpp"
 
+#include <cassert>
+
 namespace phaco {
 
 uint32_t SlotIndex::acquire(bool* appended) {
@@ -7,6 +9,7 @@ uint32_t SlotIndex::acquire(bool* appended) {
   if (!free_.empty()) {
     const uint32_t i = free_.back();
     free_.pop_back();
+    assert(i < size() && !alive_[i] && "a live or missing slot on the free list");
     alive_[i] = 1;
     *appended = false;
     return i;
@@ -19,6 +22,7 @@ uint32_t SlotIndex::acquire(bool* appended) {
 
 uint32_t SlotIndex::append(uint32_t n) {
   const uint32_t first = size();
+  assert(n < kInvalidIndex - first && "the table would reach the invalid index");
   generation_.resize(first + n, 0);
   alive_.resize(first + n, 1);
   return first;
@@ -27,6 +31,8 @@ uint32_t SlotIndex::append(uint32_t n) {
 bool SlotIndex::release(uint32_t i) {
   if (!alive(i)) return false;
   alive_[i] = 0;
+  // A wrapped generation would make handles from 2^32 removals ago valid again.
+  assert(generation_[i] != UINT32_MAX && "slot generation wrapped");
   ++generation_[i];  // stale handles to this slot stop validating
   free_.push_back(i);
   return true;
@@ -44,6 +50,7 @@ Remap SlotIndex::compact() {
     ++next;
   }
   remap.new_size = next;
+  assert(next == live_count() && "the free list and the alive mask disagree");
   generation_.resize(next);
   alive_.resize(next);
   free_.clear();

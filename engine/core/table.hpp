@@ -110,6 +110,8 @@ uint32_t table_add(T& table) {
 
 template <SoaTable T>
 bool table_remove(T& table, uint32_t i) {
+  // A dead slot is a no-op by design; an index past the table is a corrupted index column.
+  assert(i < table.slots.size() && "removing an element past the table");
   return table.slots.release(i);
 }
 

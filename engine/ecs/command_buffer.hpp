@@ -8,9 +8,10 @@
 // number of threads as long as keys are unique; equal keys keep worker order.
 // Recording may allocate (structural changes are rare events, not per-element work).
 //
-// Thread-safety (issue 22): a CommandBuffer is one worker's; its methods are not thread-safe.
-// CommandQueues::for_worker(w) may be called from every worker at once, each with its own w (the
-// `worker` of parallel_for); pending() and apply() only when no system runs (the sync point).
+// Thread-safety (issue 22), stated on every public method below as "Thread:": a CommandBuffer
+// is one worker's, used by one thread at a time. CommandQueues::for_worker(w) may be called from
+// every worker at once, each with its own w (the `worker` of parallel_for); pending() and apply()
+// only when no system runs (the sync point).
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -25,6 +26,7 @@ struct Command {
   std::function<void(World&)> apply;
 };
 
+// Every method. Thread: the buffer's worker only.
 class CommandBuffer {
  public:
   void push(uint64_t key, std::function<void(World&)> apply) {
@@ -73,10 +75,15 @@ class CommandQueues {
  public:
   explicit CommandQueues(int workers = 1)
       : buffers_(static_cast<size_t>(workers < 1 ? 1 : workers)) {}
+  // Worker `worker`'s buffer (std::out_of_range past workers()). Thread: any worker, each with
+  // its own index, concurrently.
   CommandBuffer& for_worker(int worker) { return buffers_.at(static_cast<size_t>(worker)); }
+  // Thread: any (the count is fixed at construction).
   int workers() const { return static_cast<int>(buffers_.size()); }
+  // Commands recorded and not yet applied. Thread: only when no system runs.
   size_t pending() const;
   // Merges in worker order, stable-sorts by key, applies, clears. Returns how many were applied.
+  // Thread: only when no system runs (the sync point; it makes structural World calls).
   size_t apply(World& world);
 
  private:

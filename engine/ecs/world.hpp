@@ -6,14 +6,16 @@
 // Component storage is one pool per type: entity index -> component, iterated in entity-index
 // order so that every walk over the world is deterministic.
 //
-// Thread-safety (issue 22; per method below where it differs):
-//   - structural calls (create, destroy, add, remove, name_component) change the pools: only with
-//     no system running, i.e. while the scene is built or from CommandQueues::apply at the frame's
+// Thread-safety (issue 22), stated on every public method below as "Thread:":
+//   - structural: create, destroy, add, remove, name_component change the pools; only with no
+//     system running, i.e. while the scene is built or from CommandQueues::apply at the frame's
 //     sync point;
-//   - lookups (alive, kind, name, find, get, at, has, each) may run from several systems at once,
-//     as the frame graph schedules them: they read the pools without changing them. What they
-//     return is shared by the systems that declared it; two systems writing one component never
-//     run together (the graph is built from SystemDesc reads/writes, checked in debug builds).
+//   - lookup: alive, kind, name, find, entities, entity_count, get, at, has, each, access_name
+//     may run from several systems at once, as the frame graph schedules them: they read the
+//     pools without changing them. What they return is shared by the systems that declared it;
+//     two systems writing one component never run together (the graph is built from SystemDesc
+//     reads/writes, checked in debug builds).
+#include <cassert>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -66,19 +68,32 @@ struct Pool final : PoolBase {
 
 class World {
  public:
-  // Not thread-safe: no system may run (see above).
+  // Thread: structural (no system running).
   Entity create(EntityKind kind, std::string name);
   // Removes the entity and all its components; false if it was already gone (stale handle).
-  // Not thread-safe: no system may run.
+  // Thread: structural.
   bool destroy(Entity e);
-  bool alive(Entity e) const { return entities_.slots.valid(e); }
+  // False for a null, stale or destroyed handle. Thread: lookup.
+  bool alive(Entity e) const {
+    // Entities are never compacted, so a slot's generation only grows: a handle past the table or
+    // ahead of its slot's generation was made by another World, and would read as merely stale.
+    assert((e.is_null() || (e.index < entities_.slots.size() &&
+                            e.generation <= entities_.slots.generation(e.index))) &&
+           "an entity handle from another World");
+    return entities_.slots.valid(e);
+  }
+  // Thread: lookup; std::logic_error for a stale handle.
   EntityKind kind(Entity e) const { return entities_.kind[checked(e)]; }
+  // Thread: lookup; std::logic_error for a stale handle.
   const std::string& name(Entity e) const { return entities_.name[checked(e)]; }
+  // Thread: lookup.
   std::optional<Entity> find(std::string_view name) const;
-  // Live entities in index order.
+  // Live entities in index order. Thread: lookup.
   std::vector<Entity> entities() const;
+  // Thread: lookup.
   uint32_t entity_count() const { return entities_.slots.live_count(); }
 
+  // Replaces e's C if it has one. Thread: structural.
   template <class C>
   C& add(Entity e, C component) {
     auto& pool = pool_for<C>();
@@ -88,7 +103,8 @@ class World {
     return *pool.by_entity[i];
   }
   // Null when e has no C. Inside a system whose access is checked, a found component's access
-  // name must be among the system's reads or writes (std::logic_error otherwise).
+  // name must be among the system's reads or writes (std::logic_error otherwise). Thread: lookup;
+  // the component itself only by the systems that declared it.
   template <class C>
   C* get(Entity e) {
     C* c = lookup<C>(e);
@@ -99,7 +115,7 @@ class World {
   const C* get(Entity e) const {
     return const_cast<World*>(this)->get<C>(e);
   }
-  // Like get, but a missing component is a programming error.
+  // Like get, but a missing component is a programming error. Thread: lookup, as get.
   template <class C>
   C& at(Entity e) {
     C* c = get<C>(e);
@@ -107,16 +123,19 @@ class World {
     return *c;
   }
   // Whether e has C: structure, not the component's data, so not an access to declare.
+  // Thread: lookup.
   template <class C>
   bool has(Entity e) const {
     return const_cast<World*>(this)->lookup<C>(e) != nullptr;
   }
+  // Thread: structural.
   template <class C>
   bool remove(Entity e) {
     auto* pool = find_pool<C>();
     return pool && alive(e) && pool->erase(e.index);
   }
-  // f(Entity, C&) for every live entity that has C, in entity-index order.
+  // f(Entity, C&) for every live entity that has C, in entity-index order. Thread: lookup, as
+  // get; f must not make structural calls.
   template <class C, class F>
   void each(F&& f) {
     auto* pool = find_pool<C>();
@@ -131,13 +150,14 @@ class World {
 
   // Names C for the check of declared access (AccessKind above). A scene names every component
   // type its systems look up; a lookup of an unnamed type inside a checked system is an error.
+  // Thread: structural.
   template <class C>
   void name_component(std::string name, AccessKind kind = AccessKind::PerEntity) {
     const uint32_t id = detail::component_type_id<C>();
     if (access_.size() <= id) access_.resize(id + 1);
     access_[id] = ComponentAccess{std::move(name), kind};
   }
-  // The access name of e's C as SystemDesc lists it; empty for a Constant type.
+  // The access name of e's C as SystemDesc lists it; empty for a Constant type. Thread: lookup.
   template <class C>
   std::string access_name(Entity e) const {
     return access_name(e, detail::component_type_id<C>());

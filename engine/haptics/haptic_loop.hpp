@@ -57,6 +57,8 @@ struct TickInfo {
 // A plain function pointer and a context: no std::function, nothing to allocate.
 using TickFn = void (*)(void* context, const TickInfo&);
 
+// Thread-safety (issue 22), on every public method as "Thread:": one owner thread starts and
+// stops the loop; the tick function runs on the loop thread only.
 class HapticLoop {
  public:
   HapticLoop() = default;
@@ -67,19 +69,22 @@ class HapticLoop {
   // Starts the thread and returns once it has set itself up (priority, memory lock, stack) and
   // reported its RealtimeStatus; the first tick follows one period later. Throws
   // std::invalid_argument for bad settings, std::logic_error if already running,
-  // std::system_error if the thread cannot be created.
+  // std::system_error if the thread cannot be created. Thread: the owner.
   void start(TickFn tick, void* context, const LoopSettings& settings);
-  // Asks the thread to stop after its current tick and joins it. Idempotent.
+  // Asks the thread to stop after its current tick and joins it. Idempotent. Thread: the owner,
+  // never the tick function (it would join itself).
   void stop();
+  // Thread: the owner.
   bool running() const { return thread_.joinable(); }
 
-  // Valid after start() returned (and after stop()).
+  // Valid after start() returned (and after stop()). Thread: the owner (the loop thread writes
+  // them only before start() returns).
   RealtimeStatus realtime_status() const { return status_; }
   int64_t start_ns() const { return start_ns_; }  // deadline of tick 0
   const LoopSettings& settings() const { return settings_; }
   // Any thread, also while running (approximate then; see loop_stats.hpp).
   LoopStatsSnapshot stats() const { return stats_.snapshot(); }
-  // The period's histogram bins (charts of the period under load).
+  // The period's histogram bins (charts of the period under load). Thread: any, as stats().
   std::vector<DurationHistogram::Bin> period_bins() const {
     return stats_.period().occupied_bins();
   }

@@ -4,6 +4,7 @@
 // version() from the one reader, concurrently; neither waits nor allocates.
 #include <array>
 #include <atomic>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -20,11 +21,14 @@ class Seqlock {
   static constexpr std::size_t kWords = (sizeof(T) + 7) / 8;
 
  public:
+  // Thread: the one writer.
   void store(const T& v) noexcept {
     uint64_t w[kWords] = {};
     std::memcpy(w, &v, sizeof(T));
     // Relaxed: this thread is the only writer of seq_.
     const uint32_t s = seq_.load(std::memory_order_relaxed);
+    // Even between stores; odd here means a second writer is inside store() (one writer only).
+    assert((s & 1u) == 0 && "Seqlock::store from two threads");
     seq_.store(s + 1, std::memory_order_relaxed);
     // Release fence: the odd count is visible before any new word is.
     std::atomic_thread_fence(std::memory_order_release);
@@ -34,6 +38,7 @@ class Seqlock {
     seq_.store(s + 2, std::memory_order_release);
   }
 
+  // False when never written or when every try met a write. Thread: the one reader.
   bool load(T& out) const noexcept {
     for (int attempt = 0; attempt < 4; ++attempt) {
       // Acquire: pairs with the writer's final release store; the words read below are at least
@@ -56,7 +61,8 @@ class Seqlock {
     return false;
   }
 
-  // Changes on every store. Acquire: a reader that sees a new version then loads the new value.
+  // Changes on every store. Thread: any (one atomic load). Acquire: a reader that sees a new
+  // version then loads the new value.
   uint32_t version() const noexcept { return seq_.load(std::memory_order_acquire); }
 
  private:

@@ -17,17 +17,18 @@ namespace phaco {
 
 class BackgroundSync {
  public:
+  // Starts the worker. Thread: the owner, as the destructor (which joins the worker).
   BackgroundSync(std::filesystem::path station, std::string centre_uri, double retry_s = 30.0);
   ~BackgroundSync();
   BackgroundSync(const BackgroundSync&) = delete;
   BackgroundSync& operator=(const BackgroundSync&) = delete;
 
-  // Asks for a sync as soon as the worker is free (a new record was stored).
+  // Asks for a sync as soon as the worker is free (a new record was stored). Thread: any.
   void request();
   // One line for the trainer's panel: "centre: 12 uploaded (all synced)", "centre unreachable
-  // (retrying in 30 s): …", never the password.
+  // (retrying in 30 s): …", never the password. Thread: any.
   std::string status() const;
-  // Syncs finished (successful or not), for tests.
+  // Syncs finished (successful or not), for tests. Thread: any.
   int attempts() const;
 
  private:

@@ -1,5 +1,6 @@
-// One file: the five passes share one GL state, one set of buffers per body slot and the shaders
-// (Renderer::Impl); split, they would share it through a second, internal header for no gain.
+// Over 600 lines on purpose: the five passes share one GL state, buffers and shaders (Impl).
+// Split, they would share Renderer::Impl (one set of buffers per body slot, the shaders) through a
+// second, internal header for no gain.
 // The microscope view (renderer.hpp). Per view (one, or two for side-by-side stereo) the passes
 // are:
 //   1. opaque tissue: sclera, iris, lens surface (red reflex dimmed by the lens's thickness map,

@@ -5,6 +5,8 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -94,6 +96,10 @@ struct Executor::Impl {
   bool costs_known = false;
   uint64_t graph_frames = 0;
   uint64_t serial_frames = 0;
+#ifndef NDEBUG
+  // Set while run_frame runs (it is not reentrant; executor.hpp).
+  std::atomic<bool> in_frame{false};
+#endif
 
   Impl(const FrameGraph& g, int n, const ExecutorSettings& s)
       : graph(g), threads(n), settings(s), parallelism(raise_parallelism(n)), arena(n) {}
@@ -236,6 +242,16 @@ Executor::~Executor() {
 
 void Executor::run_frame(const FrameContext& ctx) {
   Impl& im = *impl_;
+#ifndef NDEBUG
+  // A frame overlapping another (a system calling run_frame, or a second thread) would run the
+  // systems twice at once over the same components, and overwrite im.ctx under the first.
+  [[maybe_unused]] const bool overlapping = im.in_frame.exchange(true);
+  assert(!overlapping && "Executor::run_frame is not reentrant");
+  struct Leave {
+    std::atomic<bool>& flag;
+    ~Leave() { flag.store(false); }
+  } leave{im.in_frame};
+#endif
   const Clock::time_point t0 = Clock::now();
   im.ctx = ctx;
   if (!im.use_graph()) {

@@ -47,13 +47,15 @@ struct ExecutorSettings {
   double dispatch_cost_ms = 0.05;
 };
 
-// Thread-safety (issue 22): an Executor is driven by one thread (the simulation's). run_frame is
-// not reentrant and must not overlap another call on the same executor; the systems it runs may
-// use parallel_for inside its task arena. The getters read what the last run_frame left: call
-// them from the driving thread between frames. Two executors on two threads are independent.
+// Thread-safety (issue 22), stated on every public method below as "Thread:": an Executor is
+// driven by one thread (the simulation's). run_frame is not reentrant and must not overlap
+// another call on the same executor; the systems it runs may use parallel_for inside its task
+// arena. The getters read what the last run_frame left: call them from the driving thread between
+// frames. Two executors on two threads are independent.
 class Executor {
  public:
   // threads >= 1 (std::invalid_argument otherwise). The graph must outlive the executor.
+  // Thread: any; the executor then belongs to the thread that drives it.
   Executor(const FrameGraph& graph, int threads, AccessCheck check = AccessCheck::BuildDefault);
   Executor(const FrameGraph& graph, int threads, const ExecutorSettings& settings);
   Executor(FrameGraph&&, int, AccessCheck = AccessCheck::BuildDefault) = delete;
@@ -64,20 +66,29 @@ class Executor {
 
   // Runs every system once, concurrently where the graph allows, and returns when all have
   // finished. A system's exception is rethrown here after the frame has drained; the executor
-  // stays usable.
+  // stays usable. Thread: the driving thread; not reentrant (a system must not call it).
   void run_frame(const FrameContext& ctx);
 
+  // Fixed at construction. Thread: any.
   int threads() const;
+  // Fixed at construction. Thread: any.
   bool checks_access() const;
   // Frames run through the flow graph and serially so far (Auto's choices; for the harness).
+  // Thread: the driving thread, between frames.
   uint64_t graph_frames() const;
   uint64_t serial_frames() const;
+  // Thread: any (the graph is immutable).
   const FrameGraph& graph() const;
 
-  const std::vector<SystemTiming>& timings() const;  // one per system, in graph order
-  const SystemTiming& frame_timing() const;          // the whole run_frame
-  // Keeps run_frame allocation-free for the next `frames` frames.
+  // One per system, in graph order. Thread: the driving thread, between frames (run_frame
+  // appends to them).
+  const std::vector<SystemTiming>& timings() const;
+  // The whole run_frame. Thread: as timings().
+  const SystemTiming& frame_timing() const;
+  // Keeps run_frame allocation-free for the next `frames` frames. Thread: the driving thread,
+  // between frames.
   void reserve_frames(size_t frames);
+  // Thread: the driving thread, between frames.
   void clear_timings();
 
  private:

@@ -76,30 +76,41 @@ class HapticSession final : public HapticPort {
   HapticSession(const HapticSession&) = delete;
   HapticSession& operator=(const HapticSession&) = delete;
 
-  // Before start(): a device drives `hand`'s tool and receives its force.
+  // Thread-safety (issue 22), on every public method as "Thread:". The owner (the thread that
+  // builds the session: the simulation's) attaches, starts and stops; the HapticPort calls come
+  // from the simulation thread once per frame; the tick runs on the 1 kHz thread.
+
+  // Before start(): a device drives `hand`'s tool and receives its force (std::logic_error while
+  // running). Thread: the owner.
   void attach(Hand hand, std::unique_ptr<Device> device);
+  // Thread: any (devices change only before start()).
   Device* device(Hand hand) const { return hands_[index(hand)].device.get(); }
 
-  void start();  // starts the devices, then the 1 kHz thread
-  void stop();   // stops the thread, then the devices; idempotent
+  void start();  // starts the devices, then the 1 kHz thread. Thread: the owner.
+  void stop();   // stops the thread, then the devices; idempotent. Thread: the owner.
+  // Thread: the owner.
   bool running() const { return loop_.running(); }
 
+  // Thread: any, also while running (relaxed counters: approximate then, exact after stop()).
   HapticSessionStats stats() const;
   // One tick on the calling thread at the caller's time (info.wake_ns is "now" for the devices),
   // instead of the 1 kHz thread: deterministic tests of what a tick does at a given instant (the
   // silence bound). Only while the session is not running; throws std::logic_error otherwise.
+  // Thread: the owner.
   void step(const TickInfo& info);
 
-  // The 1 kHz thread's period histogram (occupied bins), for the harness's charts.
+  // The 1 kHz thread's period histogram (occupied bins), for the harness's charts. Thread: any.
   std::vector<DurationHistogram::Bin> period_bins() const { return loop_.period_bins(); }
 
-  // HapticPort (simulation thread).
+  // HapticPort. Thread: the simulation thread only (the ring's consumer, the triple buffer's
+  // producer), concurrently with the 1 kHz thread.
   bool drives(Hand hand) const override { return hands_[index(hand)].device != nullptr; }
   bool newest_pose(Hand hand, ToolPose& pose) override;
   HapticModel& model_slot() override { return models_.write_slot(); }
   void publish_model() override;
 
   // The haptic thread's view, for tests and the harness: the last force sent per hand.
+  // Thread: any (relaxed atomics: each component is the newest, the three may straddle a tick).
   Vec3 last_force(Hand hand) const;
 
  private:

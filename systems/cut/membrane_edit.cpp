@@ -1,9 +1,12 @@
 #include "systems/cut/membrane_edit.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "engine/core/invariants.hpp"
 
 namespace phaco::cut {
 namespace {
@@ -512,6 +515,14 @@ void refresh_since(CutMesh& m, EditLog& log, size_t touched_before) {
 }
 
 void refresh_region(CutMesh& m, EditLog& log) {
+  // After a batch of edits: every live triangle and spring names a particle slot, and the
+  // per-triangle and per-particle arrays cover the tables (check_topology says more, slower).
+  [[maybe_unused]] const size_t np = m.particles.slots.size();
+  assert(live_all_below(m.triangles.slots, {m.triangles.a, m.triangles.b, m.triangles.c}, np));
+  assert(live_all_below(m.springs.slots, {m.springs.i, m.springs.j}, np));
+  assert(m.topology.adjacency.neighbour.size() == m.triangles.slots.size());
+  assert(same_size(m.topology.rest_x, m.topology.rest_y, m.topology.rest_z) &&
+         m.topology.rest_x.size() >= np && m.topology.vertex_triangle.size() >= np);
   std::vector<uint32_t> tris = log.touched_triangles, on_edge, fan, corners;
   std::sort(tris.begin(), tris.end());
   tris.erase(std::unique(tris.begin(), tris.end()), tris.end());

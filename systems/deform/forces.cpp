@@ -1,8 +1,10 @@
 #include "systems/deform/forces.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "systems/deform/particle_set.hpp"
 #include "systems/deform/spring_law.hpp"
 #include "systems/springs/springs.hpp"
@@ -30,6 +32,12 @@ uint32_t compute_forces(Membrane& m, ForceTerms terms) {
   const Particles& p = m.particles;
   const uint32_t n = p.slots.size();
   Forces& f = m.forces;
+  // What a cut or a compaction leaves must name particles and springs that exist: the springs'
+  // ends, the blocks' ranges and the active lists (an index past them is read without a check).
+  assert(live_all_below(m.springs.slots, {m.springs.i, m.springs.j}, n));
+  assert(m.blocks.particle_begin.empty() || m.blocks.particle_begin.back() <= n);
+  assert(m.blocks.tail_begin() <= m.springs.slots.size());
+  assert(all_below(m.active, n) && all_below(m.active_springs, m.springs.slots.size()));
   if (f.fx.size() != n || f.fy.size() != n || f.fz.size() != n) f.resize_zero(n);  // first use only
   const ParticleSet set = particles_in_play(m);
   const bool restricted = !m.active.empty();

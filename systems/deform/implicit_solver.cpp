@@ -4,6 +4,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 
 #include "engine/schedule/parallel.hpp"
@@ -39,6 +40,13 @@ std::optional<Preconditioner> parse_preconditioner(std::string_view s) {
 namespace implicit_detail {
 
 namespace {
+
+// One block per entry of the pattern (a block array of an older pattern would be read past its
+// end, or pair blocks with the wrong columns).
+[[maybe_unused]] bool blocks_match(const BlockPattern& pattern, std::span<const Sym3> blocks) {
+  return blocks.size() == (pattern.row_begin.empty() ? 0 : pattern.row_begin.back()) &&
+         pattern.col.size() == blocks.size();
+}
 
 inline double sym_at(const Sym3& k, int a, int b) {
   static constexpr int kIndex[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
@@ -259,6 +267,7 @@ size_t map_two_level_rows(const ImplicitCache& cache, PreconditionerState& state
 
 void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks, const double* x,
                        double* y, double alpha, const ImplicitSettings& settings) {
+  assert(blocks_match(pattern, blocks));
   for_rows(pattern.rows(), settings, [&](uint32_t begin, uint32_t end) {
     for (uint32_t u = begin; u < end; ++u) {
       double s[3];
@@ -288,6 +297,7 @@ void write_matrix_pattern(const BlockPattern& pattern,
 
 void write_matrix_values(const BlockPattern& pattern, std::span<const Sym3> blocks,
                          Eigen::SparseMatrix<double, Eigen::RowMajor, int>& matrix) {
+  assert(blocks_match(pattern, blocks) && matrix.rows() == 3 * static_cast<int>(pattern.rows()));
   double* val = matrix.valuePtr();
   const int* outer = matrix.outerIndexPtr();
   for (uint32_t u = 0; u < pattern.rows(); ++u)

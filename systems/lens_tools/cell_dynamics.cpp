@@ -1,8 +1,10 @@
 #include "systems/lens_tools/cell_dynamics.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::lens_tools {
@@ -12,6 +14,7 @@ constexpr uint32_t kGrain = 2048;
 }
 
 void aspirate(const CellSpans& cells, const Aspirator& a, const AspiratorSettings& s, double dt_s) {
+  assert(cells.in_step());
   const float radius = static_cast<float>(s.radius_mm);
   const float f0 = static_cast<float>(s.force_per_mmhg * std::max(a.vacuum_mmhg, 0.0));
   const float dt = static_cast<float>(dt_s);
@@ -56,6 +59,7 @@ double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
 }
 
 void drag_with_hook(const CellSpans& cells, const Hook& h, const HookSettings& s, double dt_s) {
+  assert(cells.in_step());
   if (!(s.radius_mm > 0) || !(dt_s > 0) || !(s.drag_rate_per_s > 0)) return;
   const float beta = static_cast<float>(1.0 - std::exp(-s.drag_rate_per_s * dt_s));
   const float r2 = static_cast<float>(s.radius_mm * s.radius_mm);
@@ -93,6 +97,7 @@ void drag_with_hook(const CellSpans& cells, const Hook& h, const HookSettings& s
 }
 
 void integrate(const CellSpans& cells, const Medium& m, double dt_s) {
+  assert(cells.in_step());
   const float dt = static_cast<float>(dt_s);
   const float gx = static_cast<float>(m.gravity.x()), gy = static_cast<float>(m.gravity.y()),
               gz = static_cast<float>(m.gravity.z());

@@ -1,9 +1,11 @@
 #include "systems/lens_tools/constraints.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::lens_tools {
@@ -120,6 +122,8 @@ struct FastBall {
 }  // namespace
 
 void constrain(const CellSpans& cells, const EyeBounds& bounds, std::span<uint8_t> contact) {
+  // No flags, or one per cell (a short flag column would otherwise be ignored without a word).
+  assert(cells.in_step() && (contact.empty() || contact.size() == cells.size()));
   const bool flags = contact.size() == cells.size();
   const FastBall cornea(bounds.cornea), anterior(bounds.anterior_capsule),
       posterior(bounds.posterior_capsule);

@@ -1,8 +1,11 @@
 #include "systems/lens_tools/crack.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
+
+#include "engine/core/invariants.hpp"
 
 namespace phaco::lens_tools {
 
@@ -19,6 +22,7 @@ struct Nearest {
 
 CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& chopper_tip,
                      const CrackSettings& s, CrackState& state) {
+  assert(same_size(c.x, c.y, c.z, c.alive, c.hardness, c.label));
   CrackPush out;
   const Vec3f p = probe_tip.cast<float>(), q = chopper_tip.cast<float>();
   const Vec3f m = 0.5f * (p + q);
@@ -64,6 +68,8 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
 void links_across(const CrackCells& c, std::span<const std::array<uint32_t, 4>> neighbour,
                   uint32_t fragment, const Vec3& mid, const Vec3& normal,
                   std::vector<std::pair<uint32_t, uint32_t>>& out) {
+  // One neighbour row per cell (kNone or a cell).
+  assert(same_size(c.x, c.y, c.z, c.alive, c.hardness, c.label, neighbour));
   out.clear();
   const Vec3f m = mid.cast<float>(), nn = normal.cast<float>();
   auto side = [&](uint32_t i) { return (Vec3f(c.x[i], c.y[i], c.z[i]) - m).dot(nn); };

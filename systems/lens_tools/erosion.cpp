@@ -1,8 +1,10 @@
 #include "systems/lens_tools/erosion.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "systems/lens_tools/collect_ids.hpp"
 
 namespace phaco::lens_tools {
@@ -70,6 +72,7 @@ float removal_probability(const Vec3f& cell, float hardness, const PhacoTip& tip
 void erode(const CellSpans& cells, const PhacoTip& tip, const ErosionSettings& s,
            const CounterRng& rng, uint64_t frame, double dt_s, ErosionScratch& scratch,
            std::vector<uint32_t>& removed) {
+  assert(cells.in_step());
   const Cone cone = make_cone(tip, s, dt_s);
   if (cone.scale <= 0.0f) {  // pedal below 3, or no time: nothing to draw
     removed.clear();

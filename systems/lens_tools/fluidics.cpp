@@ -1,7 +1,10 @@
 #include "systems/lens_tools/fluidics.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+
+#include "engine/core/invariants.hpp"
 
 namespace phaco::lens_tools {
 
@@ -31,6 +34,7 @@ double holding_force_mn(double vacuum_mmhg, const FluidicsSettings& s) {
 PortCover port_cover(const CellSpans& cells, std::span<const float> volume,
                      std::span<const uint32_t> label, uint32_t fragments, const Vec3& port,
                      const FluidicsSettings& s, std::vector<double>& per_fragment) {
+  assert(cells.in_step() && same_size(cells.x, volume, label));
   PortCover out;
   if (per_fragment.size() < fragments) per_fragment.resize(fragments);
   std::fill(per_fragment.begin(), per_fragment.begin() + fragments, 0.0);
@@ -54,6 +58,7 @@ PortCover port_cover(const CellSpans& cells, std::span<const float> volume,
 void draw_to_tip(const CellSpans& cells, std::span<const uint32_t> members, const Vec3& port,
                  const Vec3& tip_velocity, const Vec3& nearest, const FluidicsSettings& s,
                  double dt_s) {
+  assert(cells.in_step() && all_below(members, cells.size()));
   const Vec3 to_port = port - nearest;
   const double d = to_port.norm();
   Vec3 target = tip_velocity;

@@ -1,8 +1,10 @@
 #include "systems/nucleus/rotation.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::nucleus {
@@ -72,6 +74,7 @@ double rotation_step(NucleusRotation& state, double torque, const RotationSettin
 
 void rotate_about_axis(std::span<float> x, std::span<float> y, std::span<float> z, const Axis& axis,
                        double theta_rad) {
+  assert(same_size(x, y, z));
   if (theta_rad == 0) return;
   const Eigen::Matrix3d r = Eigen::AngleAxisd(theta_rad, unit_direction(axis)).toRotationMatrix();
   const Vec3 o = axis.point;

@@ -1,6 +1,9 @@
 #include "systems/sculpt/sculpt.hpp"
 
 #include <algorithm>
+#include <cassert>
+
+#include "engine/core/invariants.hpp"
 
 namespace phaco::sculpt {
 
@@ -57,10 +60,25 @@ bool seed_from_last(const TetTopology& topo, std::span<const Vec3> positions, Sc
   return false;
 }
 
+// The topology's per-tet columns in step with its count, and every tet's corners among the
+// positions it is sculpted against (a lens whose vertices were rebuilt without its topology).
+[[maybe_unused]] bool topology_fits(const TetTopology& topo, size_t vertex_count) {
+  if (topo.vertices.size() != topo.tet_count ||
+      !same_size(topo.vertices, topo.neighbours, topo.alive, topo.centre_x, topo.centre_y,
+                 topo.centre_z, topo.bound_radius, topo.volume, topo.surface_slot)) {
+    return false;
+  }
+  for (const std::array<uint32_t, 4>& tet : topo.vertices) {
+    if (!all_below(tet, vertex_count)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::span<const uint32_t> sculpt_step(TetTopology& topo, std::span<const Vec3> positions,
                                       SculptState& s, const SculptTip& tip_in) {
+  assert(topology_fits(topo, positions.size()));
   s.removed.clear();
   s.queue.clear();
   s.stats = SculptStats{};

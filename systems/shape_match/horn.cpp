@@ -3,8 +3,11 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
+
+#include "engine/core/invariants.hpp"
 
 namespace phaco::shape_match {
 namespace {
@@ -153,6 +156,12 @@ MomentSums<T> accumulate_moments(std::span<const Vec3T<P>> rest, std::span<const
                                  std::span<const P> masses, std::span<const uint32_t> ids,
                                  uint32_t begin, uint32_t end, const Vec3T<T>& rest_shift,
                                  const Vec3T<T>& current_shift) {
+  // Positions (and masses) indexed alike; the chunk's cell ids within them.
+  assert(same_size(rest, current) && (masses.empty() || same_size(rest, masses)));
+  assert(begin <= end &&
+         (ids.empty()
+              ? end <= rest.size()
+              : end <= ids.size() && all_below(ids.subspan(begin, end - begin), rest.size())));
   MomentSums<T> s;
   s.count = end - begin;
   for (uint32_t k = begin; k < end; ++k) {

@@ -1,8 +1,10 @@
 #include "systems/shape_match/shape_match.hpp"
 
+#include <cassert>
 #include <cmath>
 #include <limits>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::shape_match {
@@ -145,6 +147,7 @@ FragmentMatch match_fragment(std::span<const Vec3T<P>> rest, std::span<const Vec
 template <class P>
 void pull_to_goals(const FragmentMatch& f, std::span<const Vec3T<P>> rest,
                    std::span<Vec3T<P>> current, double stiffness, std::span<const uint32_t> ids) {
+  assert(same_size(rest, current) && all_below(ids, rest.size()));
   const Mat3T<double> r = f.rotation.toRotationMatrix();
   const auto n = static_cast<uint32_t>(ids.empty() ? rest.size() : ids.size());
   for (uint32_t k = 0; k < n; ++k) {
@@ -161,6 +164,9 @@ LensPassStats match_lens(std::span<const Vec3T<P>> rest, std::span<Vec3T<P>> cur
                          std::span<Quat> rotations, const MatchSettings& settings) {
   const uint32_t count = fragments.count();
   if (count == 0) return {};
+  // One rotation per fragment, cells of the fragments within the list and the positions.
+  assert(same_size(rest, current) && (masses.empty() || same_size(rest, masses)));
+  assert(rotations.size() >= count && fragments.offsets[count] <= fragments.cells.size());
   // About kCellGrain cells per chunk of fragments; the grain depends only on the fragment list.
   const uint32_t cells = fragments.offsets[count];
   const uint32_t grain = std::max<uint32_t>(

@@ -1,7 +1,9 @@
 #include "systems/sph/contact.hpp"
 
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "systems/sph/kernel.hpp"
 #include "systems/sph/neighbours.hpp"
@@ -45,6 +47,8 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
                               std::span<float> fx, std::span<float> fy, std::span<float> fz) {
   ContactStats stats;
   if (fragment_count < 2) return stats;
+  // Every column per particle, the forces too (a short one would be read or written past its end).
+  assert(same_size(in.x, in.y, in.z, in.vx, in.vy, in.vz, in.fragment, in.boundary, fx, fy, fz));
   const auto n = static_cast<uint32_t>(in.x.size());
   scratch.members.clear();
   for (uint32_t i = 0; i < n; ++i)

@@ -1,13 +1,16 @@
 #include "systems/sph/environment.hpp"
 
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::sph {
 
 uint32_t constrain_to_spheres(std::span<const ConstraintSphere> spheres,
                               const EnvironmentParticles& p, std::span<uint8_t> heavy) {
+  assert(same_size(p.x, p.y, p.z, p.vx, p.vy, p.vz, heavy));
   const auto n = static_cast<uint32_t>(p.x.size());
   return parallel_reduce_ordered(
       0u, n, 2048, 0u,

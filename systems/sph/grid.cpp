@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cmath>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::sph {
@@ -91,9 +93,78 @@ uint64_t linear_key(const Grid& g, uint32_t ix, uint32_t iy, uint32_t iz) {
   return uint64_t{ix} + uint64_t{g.dims[0]} * (uint64_t{iy} + uint64_t{g.dims[1]} * iz);
 }
 
+namespace {
+
+// The unsorted hash's lookup: open addressing on the cell key, then each table entry's particles
+// listed contiguously in input order (counts, prefix sums, fill): cell -> list, the particles
+// themselves unmoved.
+void fill_hash_table(Grid& g, uint32_t n) {
+  const uint64_t capacity = std::bit_ceil(uint64_t{2} * n);
+  g.table_mask = capacity - 1;
+  g.table_key.assign(capacity, kEmptyKey);
+  g.table_begin.assign(capacity + 1, 0);
+  for (uint32_t s = 0; s < n; ++s) {
+    const std::array<uint32_t, 3>& c = g.coord[s];
+    uint64_t t = hash_of(c[0], c[1], c[2]) & g.table_mask;
+    while (g.table_key[t] != kEmptyKey && g.table_key[t] != g.key[s]) t = (t + 1) & g.table_mask;
+    g.table_key[t] = g.key[s];
+    g.id_tmp[s] = static_cast<uint32_t>(t);
+    ++g.table_begin[t + 1];
+  }
+  for (uint64_t t = 0; t < capacity; ++t) g.table_begin[t + 1] += g.table_begin[t];
+  g.items.resize(n);
+  g.table_fill.assign(g.table_begin.begin(), g.table_begin.end() - 1);
+  for (uint32_t s = 0; s < n; ++s) g.items[g.table_fill[g.id_tmp[s]]++] = s;
+}
+
+// The sorted orders' lookup: the compact cell table over the sorted keys, the sub-cells' ranges
+// and, for a small box, the dense table from cell coordinates to cell.
+void fill_cell_table(Grid& g, uint32_t n, bool sub) {
+  // Compact cell table over the sorted keys.
+  g.slot_cell.resize(n);
+  const int shift = sub ? 3 : 0;
+  for (uint32_t s = 0; s < n; ++s) {
+    if (s == 0 || g.key[s] >> shift != g.key[s - 1] >> shift) {
+      g.cell_key.push_back(g.key[s] >> shift);
+      g.cell_begin.push_back(s);
+    }
+    g.slot_cell[s] = static_cast<uint32_t>(g.cell_key.size() - 1);
+  }
+  g.cell_begin.push_back(n);
+
+  g.sub_begin.clear();
+  if (sub) {
+    const auto cells = static_cast<uint32_t>(g.cell_key.size());
+    g.sub_begin.resize(8 * size_t{cells} + 1);
+    for (uint32_t c = 0; c < cells; ++c) {
+      uint32_t s = g.cell_begin[c];
+      for (uint32_t o = 0; o < 8; ++o) {
+        g.sub_begin[8 * c + o] = s;
+        while (s < g.cell_begin[c + 1] && g.octant[s] == o) ++s;
+      }
+    }
+    g.sub_begin[8 * size_t{cells}] = n;
+  }
+
+  // A dense table from cell coordinates to cell index when the box is small enough (the lens
+  // always is): one load instead of a binary search per neighbour cell.
+  const uint64_t box = uint64_t{g.dims[0]} * g.dims[1] * g.dims[2];
+  g.dense_cell.clear();
+  if (box <= uint64_t{8} * n + 4096) {
+    g.dense_cell.assign(box, kNoSlot);
+    for (uint32_t c = 0; c + 1 < g.cell_begin.size(); ++c) {
+      const std::array<uint32_t, 3>& cc = g.coord[g.cell_begin[c]];
+      g.dense_cell[linear_key(g, cc[0], cc[1], cc[2])] = c;
+    }
+  }
+}
+
+}  // namespace
+
 void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
                 std::span<const float> z, std::span<const float> mass, float h, CellOrder order,
                 std::span<const uint32_t> subset) {
+  assert(same_size(x, y, z) && (mass.empty() || same_size(x, mass)) && all_below(subset, x.size()));
   const uint32_t n =
       subset.empty() ? static_cast<uint32_t>(x.size()) : static_cast<uint32_t>(subset.size());
   g.order = order;
@@ -183,63 +254,9 @@ void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
   });
 
   if (order == CellOrder::UnsortedHash) {
-    // Open addressing on the cell key, then each table entry's particles listed contiguously in
-    // input order (counts, prefix sums, fill): cell -> list, the particles themselves unmoved.
-    const uint64_t capacity = std::bit_ceil(uint64_t{2} * n);
-    g.table_mask = capacity - 1;
-    g.table_key.assign(capacity, kEmptyKey);
-    g.table_begin.assign(capacity + 1, 0);
-    for (uint32_t s = 0; s < n; ++s) {
-      const std::array<uint32_t, 3>& c = g.coord[s];
-      uint64_t t = hash_of(c[0], c[1], c[2]) & g.table_mask;
-      while (g.table_key[t] != kEmptyKey && g.table_key[t] != g.key[s]) t = (t + 1) & g.table_mask;
-      g.table_key[t] = g.key[s];
-      g.id_tmp[s] = static_cast<uint32_t>(t);
-      ++g.table_begin[t + 1];
-    }
-    for (uint64_t t = 0; t < capacity; ++t) g.table_begin[t + 1] += g.table_begin[t];
-    g.items.resize(n);
-    g.table_fill.assign(g.table_begin.begin(), g.table_begin.end() - 1);
-    for (uint32_t s = 0; s < n; ++s) g.items[g.table_fill[g.id_tmp[s]]++] = s;
-    return;
-  }
-
-  // Compact cell table over the sorted keys.
-  g.slot_cell.resize(n);
-  const int shift = sub ? 3 : 0;
-  for (uint32_t s = 0; s < n; ++s) {
-    if (s == 0 || g.key[s] >> shift != g.key[s - 1] >> shift) {
-      g.cell_key.push_back(g.key[s] >> shift);
-      g.cell_begin.push_back(s);
-    }
-    g.slot_cell[s] = static_cast<uint32_t>(g.cell_key.size() - 1);
-  }
-  g.cell_begin.push_back(n);
-
-  g.sub_begin.clear();
-  if (sub) {
-    const auto cells = static_cast<uint32_t>(g.cell_key.size());
-    g.sub_begin.resize(8 * size_t{cells} + 1);
-    for (uint32_t c = 0; c < cells; ++c) {
-      uint32_t s = g.cell_begin[c];
-      for (uint32_t o = 0; o < 8; ++o) {
-        g.sub_begin[8 * c + o] = s;
-        while (s < g.cell_begin[c + 1] && g.octant[s] == o) ++s;
-      }
-    }
-    g.sub_begin[8 * size_t{cells}] = n;
-  }
-
-  // A dense table from cell coordinates to cell index when the box is small enough (the lens
-  // always is): one load instead of a binary search per neighbour cell.
-  const uint64_t box = uint64_t{g.dims[0]} * g.dims[1] * g.dims[2];
-  g.dense_cell.clear();
-  if (box <= uint64_t{8} * n + 4096) {
-    g.dense_cell.assign(box, kNoSlot);
-    for (uint32_t c = 0; c + 1 < g.cell_begin.size(); ++c) {
-      const std::array<uint32_t, 3>& cc = g.coord[g.cell_begin[c]];
-      g.dense_cell[linear_key(g, cc[0], cc[1], cc[2])] = c;
-    }
+    fill_hash_table(g, n);
+  } else {
+    fill_cell_table(g, n, sub);
   }
 }
 

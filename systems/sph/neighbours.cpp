@@ -1,8 +1,10 @@
 #include "systems/sph/neighbours.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
+#include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "systems/sph/kernel.hpp"
 
@@ -93,6 +95,8 @@ void density_chunk(const Grid& g, uint32_t b, uint32_t e, float norm, float* den
 }  // namespace
 
 void density_pass(const Grid& g, std::span<float> density, std::span<uint32_t> neighbours) {
+  // Indexed like the spans the grid was built from: every slot's particle within them.
+  assert(same_size(density, neighbours) && all_below(g.id, density.size()));
   const float norm = static_cast<float>(poly6_normalisation(g.h));
   if (g.order == CellOrder::UnsortedHash) {
     parallel_for(0, g.count, kGrain, [&](uint32_t b, uint32_t e, int) {
