@@ -307,9 +307,7 @@ void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& te
   sys.force.resize(3 * nu);
   sys.rhs.resize(3 * nu);
   sys.block.resize(cache.pattern.row_begin[nu]);
-  uint32_t chunks = std::max(1u, (nu + cache.settings.parallel_grain_rows - 1) /
-                                     std::max(cache.settings.parallel_grain_rows, 1u));
-  if (chunks > 1 && chunks % 2 == 1) ++chunks;
+  const uint32_t chunks = implicit_detail::even_chunk_count(nu, cache.settings.parallel_grain_rows);
   const uint32_t rows_per = (nu + chunks - 1) / chunks, springs_per = (ns + chunks - 1) / chunks;
   team.run(
       chunks, 2, [](uint64_t) { return true; },

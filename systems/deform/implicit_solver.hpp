@@ -38,6 +38,7 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <array>
 #include <span>
 #include <vector>
@@ -125,6 +126,14 @@ void solve_linear_system(ImplicitCache& cache, PhasedTeam* team = nullptr);
 
 // z = B⁻¹·r, B the cache's preconditioner.
 void apply_preconditioner(const ImplicitCache& cache, const double* r, double* z);
+
+// An even number of chunks of about target_rows rows each (at least one): a PhasedTeam's two
+// threads start from opposite ends and meet in the middle with equal shares.
+inline uint32_t even_chunk_count(uint32_t rows, uint32_t target_rows) {
+  target_rows = std::max(target_rows, 1u);
+  const uint32_t chunks = std::max(1u, (rows + target_rows - 1) / target_rows);
+  return chunks > 1 && chunks % 2 == 1 ? chunks + 1 : chunks;
+}
 
 // Whether the preconditioner acts row by row (Jacobi, block-Jacobi): then the solve runs as the
 // row-chunked CG below, else as Eigen's.

@@ -79,8 +79,7 @@ void solve_row_chunked(ImplicitCache& cache, PhasedTeam& team) {
   // An even number of chunks of equal size (about settings.cg_chunk_rows rows): the caller and the
   // helper start from opposite ends and meet in the middle with equal shares.
   const uint32_t target_rows = std::max(settings.cg_chunk_rows, 1u);
-  uint32_t chunks = std::max(1u, (rows + target_rows - 1) / target_rows);
-  if (chunks > 1 && chunks % 2 == 1) ++chunks;
+  uint32_t chunks = even_chunk_count(rows, target_rows);
   const uint32_t chunk_rows = std::max(1u, (rows + chunks - 1) / chunks);
   chunks = std::max(1u, (rows + chunk_rows - 1) / chunk_rows);
   const uint64_t max_iterations = uint64_t(std::max(settings.cg_max_iterations, 1));
