@@ -188,27 +188,36 @@ LevelChartFiles draw_level_charts(const std::vector<SweepRow>& rows, const fs::p
   return files;
 }
 
-std::string pareto_md(const std::vector<SweepRow>& rows, const std::string& drill,
-                      const std::string& skip_variant) {
-  std::vector<const SweepRow*> pts;
+DrillFront drill_front(const std::vector<SweepRow>& rows, const std::string& drill,
+                       const std::string& skip_variant) {
+  DrillFront front;
   std::vector<double> x, y;
   for (const auto& row : rows)
     if (row.r.ok && row.r.config.drill == drill && row.r.config.threads == 1 &&
         row.r.config.variant != skip_variant && !is_scaling_variant(row.r.config.variant) &&
         std::isfinite(row.error_pct) && row.error_pct > 0 && row.r.frame.mean_ms > 0) {
-      pts.push_back(&row);
+      front.points.push_back(&row);
       x.push_back(row.r.frame.mean_ms);
       y.push_back(row.error_pct);
     }
+  if (front.points.size() >= 2)
+    for (size_t i : pareto_indices(x, y)) front.front.push_back(front.points[i]);
+  return front;
+}
+
+std::string pareto_md(const std::vector<SweepRow>& rows, const std::string& drill,
+                      const std::string& skip_variant) {
+  const DrillFront front = drill_front(rows, drill, skip_variant);
+  const std::vector<const SweepRow*>& pts = front.points;
   if (pts.size() < 2) return "";
   std::string md =
       "**" + drill + ", the front** (cheapest first; a point with error 0 is left out):";
   bool default_on = false;
   std::string integrators;
-  for (size_t i : pareto_indices(x, y)) {
-    const auto& c = pts[i]->r.config;
-    md += " " + c.variant + " at level " + std::to_string(c.level) + " (" + fmt("%.3f", x[i]) +
-          " ms, " + fmt("%.2f", y[i]) + " %);";
+  for (const SweepRow* p : front.front) {
+    const auto& c = p->r.config;
+    md += " " + c.variant + " at level " + std::to_string(c.level) + " (" +
+          fmt("%.3f", p->r.frame.mean_ms) + " ms, " + fmt("%.2f", p->error_pct) + " %);";
     if (c.variant == "default" && c.level == 3) default_on = true;
     if (c.variant.rfind("capsule.integrator=", 0) == 0)
       integrators += (integrators.empty() ? "" : ", ") + c.variant.substr(19) + " at level " +

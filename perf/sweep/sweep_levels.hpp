@@ -54,6 +54,16 @@ struct LevelChartFiles {
 LevelChartFiles draw_level_charts(const std::vector<SweepRow>& rows,
                                   const std::filesystem::path& results_dir, int max_level);
 
+// A drill's points on 1 thread (every variant and level but `skip_variant` and the scaling
+// variants, finite error > 0) and, when there are at least two, those on the speed-against-error
+// Pareto front, cheapest first.
+struct DrillFront {
+  std::vector<const SweepRow*> points;
+  std::vector<const SweepRow*> front;
+};
+DrillFront drill_front(const std::vector<SweepRow>& rows, const std::string& drill,
+                       const std::string& skip_variant);
+
 // The Pareto front of a drill's points on 1 thread (every variant and level but `skip_variant`,
 // finite error > 0), cheapest first, and whether the default methods at level 3 lie on it; names
 // any integrator alternative on the front when the default is not (markdown paragraph).

@@ -10,6 +10,7 @@
 #include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/sweep/sweep_levels.hpp"
+#include "perf/sweep/sweep_mechanics.hpp"
 
 namespace phaco::perf {
 namespace {
@@ -497,6 +498,8 @@ std::string methods_md(const Section& s) {
       md += "![" + drill + " speed against accuracy](results/" + charts.pareto.at(drill) + ")\n";
   md += "\n";
   for (const std::string& drill : drills) md += pareto_md(rows, drill, kNoHapticsVariant);
+  if (std::find(drills.begin(), drills.end(), "capsulorhexis") != drills.end())
+    md += integrator_mechanics_md(rows, results_file(s.dir, "membrane.json"), kNoHapticsVariant);
   md +=
       "How converged each reference is, and how far the capsulorhexis's level-3 outcome moves "
       "with the time step alone, is in docs/perf_sweep.md (\"The converged reference\"): read a "

@@ -11,6 +11,7 @@
 
 #include "engine/core/error.hpp"
 #include "perf/sweep/sweep_levels.hpp"
+#include "perf/sweep/sweep_mechanics.hpp"
 #include "perf/sweep/sweep_reference.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/scene/capsule_physics.hpp"
@@ -237,6 +238,57 @@ TEST(SweepLevels, TheParetoReadingSaysWhetherTheDefaultIsOnTheFront) {
   md = pareto_md(rows, "capsulorhexis", "no haptic thread");
   EXPECT_NE(md.find("lie on the front.**"), std::string::npos);
   EXPECT_EQ(md.find("do not lie"), std::string::npos);
+}
+
+// An integrator on the capsulorhexis front replaces the default only if the membrane study's
+// static-load error at the scene's step is within kMechanicsTolerance of implicit Euler's.
+TEST(SweepMechanics, AnIntegratorOnTheFrontMustAlsoAnswerALoad) {
+  auto pt = [](const std::string& variant, int level, double ms, double err) {
+    SweepRow r = row_of("capsulorhexis", level, 1, {}, variant);
+    r.r.frame.mean_ms = ms;
+    r.error_pct = err;
+    r.r.frames = 1200, r.r.sim_s = 10.0;  // 120 steps per second
+    return r;
+  };
+  const std::vector<SweepRow> rows = {pt("default", 3, 2.0, 2.0), pt("default", 5, 4.0, 1.0),
+                                      pt("capsule.integrator=semi_implicit_001", 3, 0.5, 1.5),
+                                      pt("capsule.integrator=xpbd", 3, 0.6, 1.9)};
+  const fs::path dir = temp_dir("sweep_mechanics");
+  const auto write = [&dir](double semi_error) {
+    nlohmann::json study = nlohmann::json::array();
+    const auto add = [&study](const char* method, const char* setting, double error) {
+      study.push_back(
+          {{"part", "accuracy"}, {"method", method}, {"setting", setting}, {"error", error}});
+    };
+    add("implicit_euler", "dt 1/120 s", 0.05);
+    add("implicit_euler", "dt 1/480 s", 0.001);  // another step: not the scene's
+    add("semi_implicit_001", "dt 1/120 s", semi_error);
+    add("xpbd 8 it", "dt 1/120 s", 45.0);
+    std::ofstream(dir / "membrane.json") << study.dump();
+  };
+  write(1.0);
+  const auto errors = membrane_static_errors(dir / "membrane.json", "dt 1/120 s");
+  ASSERT_EQ(errors.count("implicit_euler"), 1u);
+  EXPECT_DOUBLE_EQ(errors.at("implicit_euler").error, 0.05);
+  EXPECT_EQ(errors.at("xpbd").method, "xpbd 8 it");
+  std::string md = integrator_mechanics_md(rows, dir / "membrane.json", "no haptic thread");
+  EXPECT_NE(md.find("(dt 1/120 s)"), std::string::npos) << md;
+  EXPECT_NE(md.find("semi_implicit_001: 100.0 %, so the default stays"), std::string::npos) << md;
+  EXPECT_NE(md.find("xpbd: 4500.0 % (xpbd 8 it), so the default stays"), std::string::npos) << md;
+  EXPECT_EQ(md.find("may replace"), std::string::npos) << md;
+  write(0.08);  // within 2x of implicit Euler's 0.05
+  md = integrator_mechanics_md(rows, dir / "membrane.json", "no haptic thread");
+  EXPECT_NE(md.find("semi_implicit_001: 8.0 %: **it may replace the default.**"), std::string::npos)
+      << md;
+  // Without the study's file nothing is judged, and says so.
+  fs::remove(dir / "membrane.json");
+  md = integrator_mechanics_md(rows, dir / "membrane.json", "no haptic thread");
+  EXPECT_NE(md.find("no integrator on the front is judged"), std::string::npos) << md;
+  // With the default on the front there is nothing to say.
+  EXPECT_EQ(integrator_mechanics_md({pt("default", 3, 2.0, 2.0), pt("default", 5, 4.0, 1.0)},
+                                    dir / "membrane.json", "no haptic thread"),
+            "");
+  fs::remove_all(dir);
 }
 
 // "Why a target is missed" is made of the points' figures: the system with the slowest frame and
