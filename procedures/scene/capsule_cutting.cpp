@@ -21,6 +21,10 @@ namespace phaco {
 
 namespace {
 
+// The width of the cystotome's bent bevel that slides in its own slit (progressive_cut.hpp,
+// CutSettings::slit_mm): about a quarter of a 27-gauge needle's 0.41 mm.
+constexpr double kCystotomeSlitMm = 0.1;
+
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
       .count();
@@ -197,8 +201,13 @@ void forceps_temporary_vertices(Scene& scene, cut::CutMesh& m, CapsuleCutting& c
 }
 
 // The cystotome cuts where its tip touches the capsule or is pressed through it; `rest_point` is
-// that point carried to the rest shape by its barycentric weights. When the tip leaves, the stroke
-// ends and becomes the flap the tear continues.
+// that point carried to the rest shape by its barycentric weights. When the tip leaves by more
+// than release_mm, the stroke ends and becomes the flap the tear continues.
+void end_stroke(CapsuleCutting& cc) {
+  if (cc.stroke.tip != kInvalidIndex) cc.flap = cc.stroke, cc.tear_state = {};
+  cc.stroke = {}, cc.stroke_lifted = false;
+}
+
 bool cystotome_contact(Scene& scene, const cut::CutMesh& m, CapsuleCutting& cc, Vec3& rest_point) {
   bool cutting = false;
   for (Entity tool : scene.tools) {
@@ -217,9 +226,14 @@ bool cystotome_contact(Scene& scene, const cut::CutMesh& m, CapsuleCutting& cc, 
       rest_point = Vec3::Zero();
       for (int k = 0; k < 3; ++k)
         rest_point += c.bary[k] * cut::rest_position(cc.topology, cut::corner(m.triangles, t, k));
+      // Back in contact away from where the stroke stopped: the blade left its hole.
+      if (cc.stroke_lifted && !cc.stroke.tool_points.empty() &&
+          (rest_point - cc.stroke.tool_points.back()).norm() > cc.release_mm)
+        end_stroke(cc);
+      cc.stroke_lifted = false;
     } else if (cc.stroke.started) {
-      if (cc.stroke.tip != kInvalidIndex) cc.flap = cc.stroke, cc.tear_state = {};
-      cc.stroke = {};
+      cc.stroke_lifted = true;
+      if (c.distance_mm > cc.release_mm) end_stroke(cc);
     }
   }
   return cutting;
@@ -267,7 +281,12 @@ void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const
   Particles& p = m.particles;
   const size_t replay_from = cc.log.origins.size();
   std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
-  if (cutting) cc.cut_segments += cut::cut_towards(m, cc.stroke, cut_at, cc.cut, cc.log).made;
+  if (cutting) {
+    // The blade slides in its own slit; the tear (below) turns off the flap's end freely.
+    cut::CutSettings blade = cc.cut;
+    blade.slit_mm = kCystotomeSlitMm;
+    cc.cut_segments += cut::cut_towards(m, cc.stroke, cut_at, blade, cc.log).made;
+  }
   if (pulling) {
     const tear::TearRunReport run = tear::tear_until_below(m, cc.flap, cc.tear_state, pull,
                                                            elongation, cc.tear, cc.cut, cc.log);
@@ -302,6 +321,7 @@ bool add_capsule_cutting(Scene& scene) {
   CapsuleSprings& sp = scene.world.at<CapsuleSprings>(capsule);
   const CapsuleSettings& cs = scene.world.at<CapsuleSettings>(capsule);
   CapsuleCutting cc;
+  cc.release_mm = scene.params.get("tools.cystotome_tip_mm");
   cc.material.springs = cs.material;
   cc.material.areal_density_kg_mm2 =
       scene.params.get("capsule.density_kg_m3") * 1e-9 * scene.params.get("capsule.thickness_mm");

@@ -54,10 +54,16 @@ struct CapsuleCutting {
   tear::TearSettings tear;
   double contact_mm = 0.05;     // cystotome tip this close to the capsule cuts,
   double penetration_mm = 0.5;  // and so does one pressed up to this far through it
-  double min_lever_mm = 0.3;    // forceps this close to the tear's tip do not tear
-  uint32_t contact_hint = 0;    // where the last tool contact was located
-  cut::CutPath stroke;          // the cystotome's current path
-  cut::CutPath flap;            // the path the tear continues (the last stroke with a tip)
+  // A stroke ends only once the tip is this far off the capsule (tools.cystotome_tip_mm): a blade
+  // lifted less than its own length is still in its hole, so a hand's tremor at the puncture or
+  // along the cut does not end the stroke. Off contact but within it, the tip cuts nothing; a
+  // stroke touched again further than this from where it stopped starts anew.
+  double release_mm = 0.3;
+  bool stroke_lifted = false;  // the stroke's tip is off contact, within release_mm
+  double min_lever_mm = 0.3;   // forceps this close to the tear's tip do not tear
+  uint32_t contact_hint = 0;   // where the last tool contact was located
+  cut::CutPath stroke;         // the cystotome's current path
+  cut::CutPath flap;           // the path the tear continues (the last stroke with a tip)
   tear::TearState tear_state;
   std::vector<float> rest_x, rest_y,
       rest_z;                            // per particle: the rest shape, swapped in for the edits

@@ -38,6 +38,7 @@ Anatomy anatomy_of(const eye::EyeParams& p) {
   a.port_radius_mm = p.get("tools.keratome_width_mm");
   a.phaco_tip_radius_mm = 0.5 * p.get("tools.phaco_tip_diameter_mm");
   a.cystotome_tip_mm = p.get("tools.cystotome_tip_mm");
+  a.capsule_half_thickness_mm = 0.5 * p.get("capsule.thickness_mm");
   return a;
 }
 
@@ -98,9 +99,11 @@ void sample_hand(Scene& scene, DrillRecord& r, int index, double t, double dt_s)
 
   // Lens: the tip point in the two half-ellipsoids; seed 003's k_f·d when nothing is held.
   const haptic_model::LensContact lc = haptic_model::lens_penetration(a.lens, p, 0.0);
-  // The cystotome must pierce the capsule lying on the lens: its tip in the cortex by up to its own
-  // size is the puncture, not a lens hit.
-  const double allowance = h.kind == ToolKind::Cystotome ? a.cystotome_tip_mm : 0.0;
+  // The capsule lies on the lens, its mid-surface on the lens's surface: a tip within its half
+  // thickness (6.5 µm) is in the capsule, e.g. forceps closing on it with a hand's tremor. The
+  // cystotome must pierce it: its tip in the cortex by up to its own size is the puncture.
+  const double allowance =
+      h.kind == ToolKind::Cystotome ? a.cystotome_tip_mm : a.capsule_half_thickness_mm;
   const bool in_lens = lc.depth_mm > allowance;
   if (in_lens && !h.in_lens)
     ++h.lens_contacts, push_event(r, t, "lens_contact", index, "depth_mm", lc.depth_mm);

@@ -56,6 +56,7 @@ struct Anatomy {
   double port_radius_mm = 0;  // a tip this close to where it entered is in the wound
   double phaco_tip_radius_mm = 0;
   double cystotome_tip_mm = 0;
+  double capsule_half_thickness_mm = 0;  // a tip this far into the lens is still in the capsule
 };
 
 struct DrillRecord {

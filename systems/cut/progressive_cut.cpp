@@ -271,6 +271,23 @@ void finish_segment(CutMesh& m, CutPath& path, const CutSettings& s, SegmentRepo
 
 }  // namespace
 
+// Behind the tip and within slit_mm of the slit's last stretch, taken as straight: the segment from
+// the tip back along the last direction, ten slit widths long (lip vertices are too sparse to
+// measure from: the remesh merges them along straight cuts).
+bool in_own_slit(const CutMesh& m, const CutPath& path, const Vec3& goal, const CutSettings& s) {
+  if (!(s.slit_mm > 0) || path.tip == kInvalidIndex || path.direction.squaredNorm() == 0)
+    return false;
+  const Vec3 from_tip = goal - pos(m, path.tip);
+  const double behind = -from_tip.dot(path.direction);
+  if (behind <= 0) return false;
+  // The slit is no longer than the path itself (from its first vertex to the tip).
+  double length = 10.0 * s.slit_mm;
+  if (!path.sources.empty() && m.particles.slots.alive(path.sources.front()))
+    length = std::min(length, (pos(m, path.tip) - pos(m, path.sources.front())).norm());
+  const Vec3 nearest = -std::min(behind, length) * path.direction;
+  return (from_tip - nearest).norm() < s.slit_mm;
+}
+
 SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, const CutSettings& s,
                           EditLog& log) {
   SegmentReport r;
@@ -299,13 +316,19 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     const Placement p0 = place(m, c0.triangle, c0.bary, s, kInvalidIndex);
     from_kind = p0.kind;
     path.max_snap_mm = std::max(path.max_snap_mm, p0.moved_mm);
-    if ((c0.position - target.position).norm() <= s.snap.vertex_snap_mm)
-      return r;  // nothing to cut yet
+    // Nothing to cut yet; a blade (slit_mm) first leaves its own puncture, so that a hand's
+    // tremor there does not set the cut's direction.
+    if ((c0.position - target.position).norm() <= std::max(s.snap.vertex_snap_mm, s.slit_mm))
+      return r;
     path.tip = realise(m, p0, log);
     path.sources.push_back(path.tip);
   }
   const Vec3 start = pos(m, path.tip);
   const Vec3 goal = target.position;
+  if (in_own_slit(m, path, goal, s)) {
+    r.stalled = true;
+    return r;
+  }
 
   std::vector<uint32_t> fan, visited;
   for (uint32_t step = 0; step < s.max_steps_per_segment; ++step) {

@@ -5,12 +5,14 @@
 // events are recorded in order.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 
 #include "engine/core/error.hpp"
+#include "engine/io/track.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/run.hpp"
@@ -152,6 +154,42 @@ TEST(CapsuleCutting, DeferredCompactionHappensAndKeepsThePhysicsSound) {
   uint64_t compactions = 0;
   expect_sound_after_every_cut(s, 0.002, 16, compactions);  // due after a few dozen changed springs
   EXPECT_GT(compactions, 2u);
+}
+
+// The demo's cystotome through its radial stroke, lifted `lift_mm` off its track for a tenth of a
+// second mid-stroke (a hand's tremor, or a hesitation), with the y it has reached there.
+std::unique_ptr<Scene> cut_with_a_lift(double lift_mm) {
+  Scenario s = demo();
+  s.duration_s = 2.5;  // through the stroke and the lift-off at its end
+  for (HandTrack& h : s.hands) {
+    if (h.tool != ToolKind::Cystotome) continue;
+    const auto at = [&h](double t) { return sample_track(h.track, t); };
+    TrackSample up, down;
+    up.t = 1.45, up.pos = at(1.45).pos + Vec3(0, 0, lift_mm), up.quat = at(1.45).quat;
+    down.t = 1.5, down.pos = at(1.5).pos, down.quat = at(1.5).quat;
+    auto it = std::find_if(h.track.begin(), h.track.end(),
+                           [](const TrackSample& x) { return x.t > 1.45; });
+    it = h.track.insert(it, up);
+    h.track.insert(it + 1, down);
+  }
+  return run_all(s, 1);
+}
+
+// A blade lifted less than its own tip length (tools.cystotome_tip_mm, 0.3 mm) is still in its
+// hole: the stroke goes on, and the whole cut is the flap the forceps will tear. Lifted clear of
+// the capsule, the stroke ends there and the cut resumes as a new stroke.
+TEST(CapsuleCutting, AStrokeSurvivesALiftShorterThanTheBlade) {
+  for (const double lift : {0.15, 0.6}) {
+    auto scene = cut_with_a_lift(lift);
+    const CapsuleCutting& cc = scene->world.at<CapsuleCutting>(*scene->body(BodyPart::Capsule));
+    ASSERT_NE(cc.flap.tip, kInvalidIndex) << "lift " << lift;
+    EXPECT_GT(cc.cut_segments, 50u) << "lift " << lift;
+    if (lift < 0.3) {
+      EXPECT_EQ(cc.flap.segments, cc.cut_segments) << "one stroke";
+    } else {
+      EXPECT_LT(cc.flap.segments, cc.cut_segments) << "the stroke ended at the lift";
+    }
+  }
 }
 
 TEST(CapsuleCutting, CanBeSwitchedOffAndRejectsAnUnknownRule) {

@@ -205,6 +205,41 @@ TEST(ProgressiveCut, ACutReachingTheRimSeparatesItAndEndsThePath) {
   EXPECT_TRUE(sound(s));
 }
 
+// A tremor swings the blade back beside its own slit. With CutSettings::slit_mm the blade slides
+// in the slit and cuts on once it is ahead of the tip again; without it, the path cuts a sliver
+// beside its own slit.
+TEST(ProgressiveCut, ABladeSwingingBackInItsSlitCutsNothing) {
+  for (const double slit : {0.0, 0.1}) {
+    CutSheet s = cut_sheet(phaco::test::grid_mesh(12, 0.0));
+    CutMesh m = s.mesh();
+    CutPath path;
+    EditLog log;
+    CutSettings cs = settings();
+    cs.slit_mm = slit;
+    for (double x = 2.0; x <= 6.01; x += 0.25) cut_towards(m, path, P(x, 5.0), cs, log);
+    ASSERT_TRUE(sound(s));
+    const uint32_t live = s.particles.slots.live_count(), segments = path.segments;
+    bool made = false;
+    for (const Vec3& back : {P(5.75, 5.07), P(5.5, 5.08), P(5.6, 4.93)})
+      made = cut_towards(m, path, back, cs, log).made || made;
+    EXPECT_TRUE(sound(s));
+    const uint32_t after_swing = s.particles.slots.live_count();
+    // Ahead of the tip again: with the rule the blade cuts on from where the slit ends; without it
+    // the path's tip has moved down the sliver, and the way ahead lies across its own lip.
+    const bool on = cut_towards(m, path, P(6.5, 5.0), cs, log).made;
+    EXPECT_TRUE(sound(s));
+    if (slit > 0) {
+      EXPECT_FALSE(made) << "slid in the slit";
+      EXPECT_EQ(after_swing, live);
+      EXPECT_EQ(path.segments, segments + 1);
+      EXPECT_TRUE(on);
+    } else {
+      EXPECT_TRUE(made) << "without the rule the swing cuts beside the slit";
+      EXPECT_FALSE(on);
+    }
+  }
+}
+
 TEST(ProgressiveCut, PrestretchedSpringsPullTheLipsApart) {
   CutSheet s = cut_sheet(phaco::test::grid_mesh(10, 0.15), 0.05, springs::Pretension::Cotangent);
   CutMesh m = s.mesh();
