@@ -47,8 +47,16 @@ struct SnapshotFillCache {
   std::vector<std::array<uint32_t, 3>> faces;     // scratch: global-index triangles
   std::vector<std::array<uint32_t, 3>> interior;  // scratch: newly exposed faces
   simplex::BoundarySurface boundary;              // fragments lens
-  std::vector<uint8_t> face_was_external;         // fragments lens, per face id, at first fill
-  std::vector<Vec3> ports;                        // guidance ports when no ports record
+  // The tet lens's two views as last compacted (their triangles and, per view vertex, its
+  // particle): sculpting only removes tets, so while alive_count stands still the faces do too
+  // and a fill re-gathers positions only, instead of walking every surface tet (120 times a
+  // second: the largest part of this function's cost in the sculpting drill).
+  const TetTopology* lens_topology = nullptr;
+  uint32_t lens_alive = 0;
+  size_t lens_particles = 0;
+  std::array<std::vector<uint32_t>, 2> lens_tris, lens_nodes;  // outer, inner
+  std::vector<uint8_t> face_was_external;  // fragments lens, per face id, at first fill
+  std::vector<Vec3> ports;                 // guidance ports when no ports record
   bool ports_made = false;
   float reflex_attenuation = -1;        // lens, 1/mm; set at the first fill
   std::optional<eye::EyeGeometry> eye;  // the depth cue's layout; set at the first fill
@@ -66,11 +74,16 @@ float reflex_attenuation(const Scene& scene) {
   return static_cast<float>(0.2 + 0.4 * std::clamp(hardness, 0.0, 1.0));
 }
 
+// FNV-1a over four interleaved lanes, then the lanes and the length: a quarter of the dependent
+// multiplies of one lane (every fill hashes every body's indices, 120 times a second).
 uint64_t fnv(uint64_t h, std::span<const uint32_t> v) {
-  for (uint32_t x : v) {
-    h ^= x;
-    h *= 0x100000001b3ull;
-  }
+  constexpr uint64_t kPrime = 0x100000001b3ull;
+  uint64_t lane[4] = {h, h ^ 1, h ^ 2, h ^ 3};
+  size_t i = 0;
+  for (; i + 4 <= v.size(); i += 4)
+    for (size_t k = 0; k < 4; ++k) lane[k] = (lane[k] ^ v[i + k]) * kPrime;
+  for (; i < v.size(); ++i) lane[0] = (lane[0] ^ v[i]) * kPrime;
+  for (uint64_t x : {lane[0], lane[1], lane[2], lane[3], uint64_t{v.size()}}) h = (h ^ x) * kPrime;
   return h;
 }
 
@@ -190,6 +203,22 @@ void fill_surface(BodyView& v, const Particles& p, const Triangles& t, SnapshotF
 // (no neighbour in the mesh) and the faces sculpting exposed (a removed neighbour).
 void fill_tet_lens(BodyView& outer, BodyView& inner, const Particles& p, const TetTopology& topo,
                    SnapshotFillCache& cache) {
+  outer.piece.clear(), inner.piece.clear();  // one piece
+  if (cache.lens_topology == &topo && cache.lens_alive == topo.alive_count &&
+      cache.lens_particles == p.x.size()) {
+    // The snapshot slot may hold another fill's views (triple buffer): copy the cached ones.
+    BodyView* views[2] = {&outer, &inner};
+    for (size_t k = 0; k < 2; ++k) {
+      BodyView& v = *views[k];
+      v.tris.assign(cache.lens_tris[k].begin(), cache.lens_tris[k].end());
+      v.xyz.resize(3 * cache.lens_nodes[k].size());
+      for (size_t m = 0; m < cache.lens_nodes[k].size(); ++m) {
+        const uint32_t i = cache.lens_nodes[k][m];
+        v.xyz[3 * m] = p.x[i], v.xyz[3 * m + 1] = p.y[i], v.xyz[3 * m + 2] = p.z[i];
+      }
+    }
+    return;
+  }
   cache.faces.clear();
   cache.interior.clear();
   for (uint32_t t : topo.surface) {
@@ -203,8 +232,14 @@ void fill_tet_lens(BodyView& outer, BodyView& inner, const Particles& p, const T
     }
   }
   compact_faces(outer, cache.faces, p.x, p.y, p.z, cache);
+  cache.lens_nodes[0].assign(cache.touched.begin(), cache.touched.end());
   compact_faces(inner, cache.interior, p.x, p.y, p.z, cache);
-  outer.piece.clear(), inner.piece.clear();  // one piece
+  cache.lens_nodes[1].assign(cache.touched.begin(), cache.touched.end());
+  cache.lens_tris[0].assign(outer.tris.begin(), outer.tris.end());
+  cache.lens_tris[1].assign(inner.tris.begin(), inner.tris.end());
+  cache.lens_topology = &topo;
+  cache.lens_alive = topo.alive_count;
+  cache.lens_particles = p.x.size();
 }
 
 // Each vertex's fragment, wrapped to a byte, so the renderer tints the pieces apart: a face node's

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <vector>
 
+#include "components/particles.hpp"
 #include "components/tet_topology.hpp"
 #include "engine/core/clock.hpp"
 #include "procedures/scene/lens_fragments.hpp"
@@ -126,6 +128,36 @@ TEST(SnapshotFill, SculptedTetLensShowsInteriorFaces) {
   EXPECT_LT(lens->tris.size(), outer0);
   EXPECT_GT(interior->tris.size(), 0u) << "the faces under the removed tets are exposed";
   EXPECT_NE(lens->topology_version, v0);
+
+  // Unsculpted frames re-use the lens's faces (alive_count unchanged) and gather the positions
+  // anew: the same views as a scene filled for the first time, into every slot of a triple buffer.
+  const uint64_t v1 = lens->topology_version;
+  auto& px = scene->world.at<Particles>(*scene->body(BodyPart::Lens)).x;
+  for (float& x : px) x += 0.01f;  // as the lens moves between frames
+  render::RenderSnapshot slots[3];
+  for (auto& slot : slots) fill_snapshot(*scene, slot);
+  std::vector<uint32_t> fresh_tris[2];
+  std::vector<float> fresh_xyz[2];
+  {
+    LensSculpting& l = scene->world.at<LensSculpting>(*scene->body(BodyPart::Lens));
+    l.topology.alive_count += 1;  // forces a rebuild (no tet comes back; restored below)
+    render::RenderSnapshot fresh;
+    fill_snapshot(*scene, fresh);
+    l.topology.alive_count -= 1;
+    for (int k = 0; k < 2; ++k) {
+      const auto* v = find_view(fresh, k == 0 ? "lens" : "lens.interior");
+      fresh_tris[k] = v->tris, fresh_xyz[k] = v->xyz;
+    }
+  }
+  for (auto& slot : slots) {
+    expect_well_formed(slot);
+    for (int k = 0; k < 2; ++k) {
+      const auto* v = find_view(slot, k == 0 ? "lens" : "lens.interior");
+      EXPECT_EQ(v->tris, fresh_tris[k]);
+      EXPECT_EQ(v->xyz, fresh_xyz[k]) << "positions follow the particles";
+    }
+    EXPECT_EQ(find_view(slot, "lens")->topology_version, v1) << "same faces, same version";
+  }
   {
     Stopwatch clock;
     for (int i = 0; i < 50; ++i) fill_snapshot(*scene, snap);
