@@ -117,7 +117,13 @@ SystemDesc cornea_cut_system(Scene& scene) {
             cut::CutMesh m{scene.world.at<Particles>(cornea), scene.world.at<Triangles>(cornea),
                            cc.springs, cc.topology, cc.material};
             cc.log.clear();
-            if (cc.cutting && (withdrawing || !now.outer.touches)) {
+            // Off the cornea only once the tip is clear of its anterior surface by the same
+            // margin: a tremor lifts a blade that has just touched it by less.
+            const double outside_mm =
+                (blade.tip - Vec3(0.0, 0.0, cc.spheres.anterior_centre_z)).norm() -
+                cc.spheres.anterior_radius_mm;
+            const bool clear = !now.outer.touches && outside_mm > kWithdrawMm;
+            if (cc.cutting && (withdrawing || clear)) {
               end_paths(m, cc);
             } else {
               // The puncture's start triangle from the grid, so the first contact scans nothing.

@@ -6,9 +6,11 @@
 
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include "components/particles.hpp"
 #include "components/triangles.hpp"
+#include "engine/io/track.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/incision/cornea_sheet.hpp"
 #include "procedures/incision/scripted_incision.hpp"
@@ -87,6 +89,40 @@ TEST(CorneaCutting, TheSceneCutsAsTheScriptedPass) {
             r.triangles_after - r.triangles_before);
   EXPECT_EQ(scene->world.at<Particles>(cornea).slots.live_count() - r.particles_before,
             r.particles_after - r.particles_before);
+}
+
+// A hand's tremor lifts a blade that has just entered the cornea back off its surface, by less
+// than the withdrawal margin (0.1 mm): the incision goes on, as wide as the pass without the lift.
+TEST(CorneaCutting, ATremorLiftJustAfterEntryDoesNotEndTheIncision) {
+  const eye::EyeParams params = eye::default_eye_params();
+  corneal_incision::IncisionScript script;
+  script.approach = {3.0, 0.3, 15.0};
+  script.shape = corneal_incision::eye_keratome(params);
+  const double advance_mm = 2.0;
+  const Scenario plain = pass_scenario(script, advance_mm);
+  Scenario lifted = plain;
+  // 0.1 mm into the cut, the whole blade is raised 0.14 mm along the surface normal for two frames
+  // (its tip then just clear of the surface: the old rule, "no longer touching", ended the cut).
+  std::vector<TrackSample>& track = lifted.hands.front().track;
+  const incision::CorneaSpheres sp = corneal_incision::cornea_spheres(params);
+  const Vec3 n = (track.front().pos - Vec3(0, 0, sp.anterior_centre_z)).normalized();
+  const double v = script.step_mm / plain.dt_s, t0 = plain.dt_s + 0.1 / v;
+  const auto at = [&plain](double t) { return sample_track(plain.hands.front().track, t); };
+  std::vector<TrackSample> lift;
+  for (const double t : {t0, t0 + plain.dt_s, t0 + 2 * plain.dt_s, t0 + 3 * plain.dt_s}) {
+    const ToolPose p = at(t);
+    const bool up = t > t0 + 0.5 * plain.dt_s && t < t0 + 2.5 * plain.dt_s;
+    lift.push_back({t, p.pos + (up ? 0.14 : 0.0) * n, p.quat});
+  }
+  track.insert(track.begin() + 1, lift.begin(), lift.end());
+  MeshIncision a, b;
+  auto one = test::run_to_end(plain, 1), two = test::run_to_end(lifted, 1);
+  ASSERT_TRUE(measure_scene_incision(*one, a));
+  ASSERT_TRUE(measure_scene_incision(*two, b));
+  ASSERT_TRUE(a.outer_cut && b.outer_cut);
+  EXPECT_GT(a.width_mm, 2.0);
+  EXPECT_NEAR(b.width_mm, a.width_mm, 0.1) << "the lift ended the incision";
+  EXPECT_TRUE(b.inner_cut && b.complete);
 }
 
 TEST(CorneaCutting, OnlyAKeratomeCuts) {
