@@ -22,8 +22,10 @@ namespace phaco {
 namespace {
 
 // The width of the cystotome's bent bevel that slides in its own slit (progressive_cut.hpp,
-// CutSettings::slit_mm): about a quarter of a 27-gauge needle's 0.41 mm.
-constexpr double kCystotomeSlitMm = 0.1;
+// CutSettings::slit_mm): about a quarter of a 27-gauge needle's 0.41 mm. Its puncture is a little
+// smaller than that; the tear's closing on the radial cut is sensitive to where the cut starts
+// (0.1 mm here made the level-1 expert's tear miss it; 0.08 keeps levels 0-8 closing).
+constexpr double kCystotomeSlitMm = 0.1, kCystotomePunctureMm = 0.08;
 
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
@@ -284,7 +286,7 @@ void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const
   if (cutting) {
     // The blade slides in its own slit; the tear (below) turns off the flap's end freely.
     cut::CutSettings blade = cc.cut;
-    blade.slit_mm = kCystotomeSlitMm;
+    blade.slit_mm = kCystotomeSlitMm, blade.puncture_mm = kCystotomePunctureMm;
     cc.cut_segments += cut::cut_towards(m, cc.stroke, cut_at, blade, cc.log).made;
   }
   if (pulling) {

@@ -316,9 +316,9 @@ SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, con
     const Placement p0 = place(m, c0.triangle, c0.bary, s, kInvalidIndex);
     from_kind = p0.kind;
     path.max_snap_mm = std::max(path.max_snap_mm, p0.moved_mm);
-    // Nothing to cut yet; a blade (slit_mm) first leaves its own puncture, so that a hand's
-    // tremor there does not set the cut's direction.
-    if ((c0.position - target.position).norm() <= std::max(s.snap.vertex_snap_mm, s.slit_mm))
+    // Nothing to cut yet; a blade first leaves its own puncture, so that a hand's tremor there
+    // does not set the cut's direction.
+    if ((c0.position - target.position).norm() <= std::max(s.snap.vertex_snap_mm, s.puncture_mm))
       return r;
     path.tip = realise(m, p0, log);
     path.sources.push_back(path.tip);

@@ -50,10 +50,13 @@ struct CutSettings {
   uint32_t max_steps_per_segment = 4096;
   uint32_t own_lip_hops = 12;  // a boundary this close to the tip along free edges is the
                                // cut's own lip, not a boundary to cut through to
-  // A blade's width. The initial cut waits until the blade is this far from its puncture, and a
-  // sample behind the tip within this distance of the slit is the blade sliding back in it (a
-  // hand's tremor): the path waits instead of cutting a sliver beside its own slit. 0: no blade.
+  // A blade's width: a sample behind the tip within this distance of the slit is the blade sliding
+  // back in it (a hand's tremor), and the path waits instead of cutting a sliver beside its own
+  // slit. 0: off.
   double slit_mm = 0.0;
+  // The hole a blade's puncture leaves: the initial cut waits until the blade is this far from it,
+  // so that a tremor there does not set the cut's direction. 0: off (the vertex snap only).
+  double puncture_mm = 0.0;
 };
 
 struct CutPath {
