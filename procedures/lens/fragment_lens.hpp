@@ -120,6 +120,8 @@ struct FragmentLens {
   lens_tools::ErosionScratch erosion;
   std::vector<uint32_t> removed;
   std::vector<simplex::Removal> removals;
+  std::vector<uint32_t> scan_ids, scan_counts, scan_hits;   // parallel scans' scratch (collect_ids)
+  std::vector<std::pair<float, uint32_t>> feed_candidates;  // (squared distance, cell)
   bool awake = false;
   // Fluidics and cracking (with settings.fluidics).
   double vacuum_mmhg = 0;
