@@ -12,6 +12,7 @@ namespace phaco::lens {
 namespace {
 
 constexpr uint32_t kCellGrain = 4096;  // per-cell passes: chunks of cells, in parallel
+constexpr uint32_t kRegionBins = 32;   // contact regions' bins per axis (mark_boundary)
 
 // Fragments per chunk of a pass over fragments: about kCellGrain cells (as shape matching).
 uint32_t fragment_grain(const FragmentLens& l) {
@@ -81,22 +82,52 @@ void mark_boundary(FragmentLens& l) {
       overlaps.push_back({order[j], r});
     }
   }
-  std::sort(overlaps.begin(), overlaps.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  auto& first = l.fragment_first_overlap;  // CSR into overlaps, per fragment
-  first.assign(nf + 1, 0);
-  for (const auto& o : overlaps) ++first[o.first + 1];
-  for (uint32_t f = 0; f < nf; ++f) first[f + 1] += first[f];
+  // Which regions a cell may lie in: bins over the regions' extent (edge at least 2h, at most
+  // kRegionBins per axis), each listing the regions that meet it; a cell tests its own bin's
+  // regions of its fragment only. A region holding a cell meets the cell's bin (the bin index is
+  // monotone in the coordinate), so the marks are those of testing every region of the fragment.
+  std::array<float, 6> ext{1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
+  for (const auto& o : overlaps)
+    for (int a = 0; a < 3; ++a)
+      ext[a] = std::min(ext[a], o.second[a]), ext[a + 3] = std::max(ext[a + 3], o.second[a + 3]);
+  uint32_t dims[3];
+  float inv[3];
+  for (int a = 0; a < 3; ++a) {
+    const float span = std::max(ext[a + 3] - ext[a], 1e-6f);
+    dims[a] = std::clamp<uint32_t>(static_cast<uint32_t>(span / (2 * h)) + 1, 1, kRegionBins);
+    inv[a] = static_cast<float>(dims[a]) / span;
+  }
+  auto bin = [&](int a, float v) {
+    const float t = (v - ext[a]) * inv[a];
+    return t > 0.0f ? std::min(static_cast<uint32_t>(t), dims[a] - 1) : 0u;
+  };
+  auto& first = l.region_bin_first;
+  auto& items = l.region_bin_items;
+  const uint32_t bins = dims[0] * dims[1] * dims[2];
+  first.assign(size_t{bins} + 1, 0);
+  auto each_bin = [&](const std::array<float, 6>& r, auto&& fn) {
+    for (uint32_t z = bin(2, r[2]); z <= bin(2, r[5]); ++z)
+      for (uint32_t y = bin(1, r[1]); y <= bin(1, r[4]); ++y)
+        for (uint32_t x = bin(0, r[0]); x <= bin(0, r[3]); ++x) fn((z * dims[1] + y) * dims[0] + x);
+  };
+  for (const auto& o : overlaps) each_bin(o.second, [&](uint32_t b) { ++first[b + 1]; });
+  for (uint32_t b = 0; b < bins; ++b) first[b + 1] += first[b];
+  items.resize(first[bins]);
+  std::vector<uint32_t>& fill = l.region_bin_fill;
+  fill.assign(first.begin(), first.end() - 1);
+  for (uint32_t k = 0; k < overlaps.size(); ++k)
+    each_bin(overlaps[k].second, [&](uint32_t b) { items[fill[b]++] = k; });
   parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
       if (!l.boundary[c]) continue;
       const uint32_t f = l.fragments.label[c];
       const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
       uint8_t in = 0;
-      for (uint32_t k = first[f]; k < first[f + 1] && !in; ++k) {
-        const auto& r = overlaps[k].second;
-        in = p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] && p[2] >= r[2] &&
-             p[2] <= r[5];
+      const uint32_t cell_bin = (bin(2, p[2]) * dims[1] + bin(1, p[1])) * dims[0] + bin(0, p[0]);
+      for (uint32_t i = first[cell_bin]; i < first[cell_bin + 1] && !in; ++i) {
+        const auto& [g, r] = overlaps[items[i]];
+        in = g == f && p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] &&
+             p[2] >= r[2] && p[2] <= r[5];
       }
       l.boundary[c] = in;
     }

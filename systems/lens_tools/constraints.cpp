@@ -117,16 +117,6 @@ SurelyInside::SurelyInside(const EyeBounds& bounds, double tolerance_mm) {
   if (bounds.rhexis_radius_mm > 0 && open > 0) open2 = static_cast<float>(open * open);
 }
 
-bool SurelyInside::operator()(float x, float y, float z) const {
-  auto in = [&](const FloatBall& b) {
-    if (!b.present) return true;
-    const float dx = x - b.cx, dy = y - b.cy, dz = z - b.cz;
-    return dx * dx + dy * dy + dz * dz <= b.r2;
-  };
-  const bool open = open2 >= 0 && x * x + y * y < open2;
-  return (open || in(anterior)) && in(posterior) && in(cornea);
-}
-
 namespace {
 
 // A float ball a little smaller than the real one (by kFastMarginMm): a cell inside it is surely

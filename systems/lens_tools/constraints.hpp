@@ -80,12 +80,19 @@ bool inside_bounds(const Vec3& p, const EyeBounds& bounds, double tolerance_mm);
 // inside_bounds alone would.
 struct SurelyInside {
   SurelyInside(const EyeBounds& bounds, double tolerance_mm);
-  bool operator()(float x, float y, float z) const;
+  bool operator()(float x, float y, float z) const {
+    const bool open = open2 >= 0 && x * x + y * y < open2;
+    return (open || in(anterior, x, y, z)) && in(posterior, x, y, z) && in(cornea, x, y, z);
+  }
 
   struct FloatBall {
     float cx = 0, cy = 0, cz = 0, r2 = 0;
     bool present = false;
   };
+  static bool in(const FloatBall& b, float x, float y, float z) {
+    const float dx = x - b.cx, dy = y - b.cy, dz = z - b.cz;
+    return !b.present || dx * dx + dy * dy + dz * dz <= b.r2;
+  }
   FloatBall cornea, anterior, posterior;
   float open2 = -1;  // (rhexis radius − margin)², < 0 without an opening
 };
