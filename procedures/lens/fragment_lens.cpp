@@ -5,12 +5,22 @@
 #include <limits>
 
 #include "engine/schedule/parallel.hpp"
+#include "systems/lens_tools/collect_ids.hpp"
 #include "systems/sph/environment.hpp"
 
 namespace phaco::lens {
 namespace {
 
 constexpr uint32_t kCellGrain = 4096;  // per-cell passes: chunks of cells, in parallel
+constexpr uint32_t kRegionBins = 32;   // contact regions' bins per axis (mark_boundary)
+
+// Fragments per chunk of a pass over fragments: about kCellGrain cells (as shape matching).
+uint32_t fragment_grain(const FragmentLens& l) {
+  const uint32_t cells =
+      std::max(1u, l.fragments.offsets.empty() ? 0u : l.fragments.offsets.back());
+  return std::max<uint32_t>(
+      1, static_cast<uint32_t>(uint64_t{l.fragments.count} * kCellGrain / cells));
+}
 
 CellSpans spans(FragmentLens& l) {
   return {l.cells.x, l.cells.y,    l.cells.z,     l.vx,      l.vy,
@@ -24,20 +34,30 @@ CellSpans spans(FragmentLens& l) {
 void mark_boundary(FragmentLens& l) {
   const uint32_t n = l.cells.size(), nf = l.fragments.count;
   const float h = l.settings.contact.h;
+  parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    for (uint32_t c = b; c < e; ++c) {
+      uint8_t ext = 0;
+      if (l.cells.alive[c]) {
+        for (uint32_t k = 0; k < 4; ++k) ext |= l.cells.neighbour[c][k] == kNoSimplex;
+      }
+      l.boundary[c] = ext;
+    }
+  });
   auto& box = l.fragment_box;  // per fragment: min x, y, z, max x, y, z of its boundary cells
   box.assign(nf, {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f});
-  for (uint32_t c = 0; c < n; ++c) {
-    uint8_t b = 0;
-    if (l.cells.alive[c]) {
-      for (uint32_t k = 0; k < 4; ++k) b |= l.cells.neighbour[c][k] == kNoSimplex;
+  // Per fragment over its members (min and max are exact: any order gives the same box).
+  parallel_for(0, nf, fragment_grain(l), [&](uint32_t fb, uint32_t fe, int) {
+    for (uint32_t f = fb; f < fe; ++f) {
+      auto& bx = box[f];
+      for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
+        const uint32_t c = l.fragments.members[k];
+        if (!l.boundary[c]) continue;
+        const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
+        for (int a = 0; a < 3; ++a)
+          bx[a] = std::min(bx[a], p[a] - h), bx[a + 3] = std::max(bx[a + 3], p[a] + h);
+      }
     }
-    l.boundary[c] = b;
-    if (!b) continue;
-    auto& bx = box[l.fragments.label[c]];
-    const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
-    for (int a = 0; a < 3; ++a)
-      bx[a] = std::min(bx[a], p[a] - h), bx[a + 3] = std::max(bx[a + 3], p[a] + h);
-  }
+  });
   // Overlaps of the widened boxes: a sweep over the fragments sorted by min x.
   auto& order = l.fragment_order;
   order.resize(nf);
@@ -62,24 +82,56 @@ void mark_boundary(FragmentLens& l) {
       overlaps.push_back({order[j], r});
     }
   }
-  std::sort(overlaps.begin(), overlaps.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  auto& first = l.fragment_first_overlap;  // CSR into overlaps, per fragment
-  first.assign(nf + 1, 0);
-  for (const auto& o : overlaps) ++first[o.first + 1];
-  for (uint32_t f = 0; f < nf; ++f) first[f + 1] += first[f];
-  for (uint32_t c = 0; c < n; ++c) {
-    if (!l.boundary[c]) continue;
-    const uint32_t f = l.fragments.label[c];
-    const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
-    uint8_t in = 0;
-    for (uint32_t k = first[f]; k < first[f + 1] && !in; ++k) {
-      const auto& r = overlaps[k].second;
-      in = p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] && p[2] >= r[2] &&
-           p[2] <= r[5];
-    }
-    l.boundary[c] = in;
+  // Which regions a cell may lie in: bins over the regions' extent (edge at least 2h, at most
+  // kRegionBins per axis), each listing the regions that meet it; a cell tests its own bin's
+  // regions of its fragment only. A region holding a cell meets the cell's bin (the bin index is
+  // monotone in the coordinate), so the marks are those of testing every region of the fragment.
+  std::array<float, 6> ext{1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
+  for (const auto& o : overlaps)
+    for (int a = 0; a < 3; ++a)
+      ext[a] = std::min(ext[a], o.second[a]), ext[a + 3] = std::max(ext[a + 3], o.second[a + 3]);
+  uint32_t dims[3];
+  float inv[3];
+  for (int a = 0; a < 3; ++a) {
+    const float span = std::max(ext[a + 3] - ext[a], 1e-6f);
+    dims[a] = std::clamp<uint32_t>(static_cast<uint32_t>(span / (2 * h)) + 1, 1, kRegionBins);
+    inv[a] = static_cast<float>(dims[a]) / span;
   }
+  auto bin = [&](int a, float v) {
+    const float t = (v - ext[a]) * inv[a];
+    return t > 0.0f ? std::min(static_cast<uint32_t>(t), dims[a] - 1) : 0u;
+  };
+  auto& first = l.region_bin_first;
+  auto& items = l.region_bin_items;
+  const uint32_t bins = dims[0] * dims[1] * dims[2];
+  first.assign(size_t{bins} + 1, 0);
+  auto each_bin = [&](const std::array<float, 6>& r, auto&& fn) {
+    for (uint32_t z = bin(2, r[2]); z <= bin(2, r[5]); ++z)
+      for (uint32_t y = bin(1, r[1]); y <= bin(1, r[4]); ++y)
+        for (uint32_t x = bin(0, r[0]); x <= bin(0, r[3]); ++x) fn((z * dims[1] + y) * dims[0] + x);
+  };
+  for (const auto& o : overlaps) each_bin(o.second, [&](uint32_t b) { ++first[b + 1]; });
+  for (uint32_t b = 0; b < bins; ++b) first[b + 1] += first[b];
+  items.resize(first[bins]);
+  std::vector<uint32_t>& fill = l.region_bin_fill;
+  fill.assign(first.begin(), first.end() - 1);
+  for (uint32_t k = 0; k < overlaps.size(); ++k)
+    each_bin(overlaps[k].second, [&](uint32_t b) { items[fill[b]++] = k; });
+  parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    for (uint32_t c = b; c < e; ++c) {
+      if (!l.boundary[c]) continue;
+      const uint32_t f = l.fragments.label[c];
+      const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
+      uint8_t in = 0;
+      const uint32_t cell_bin = (bin(2, p[2]) * dims[1] + bin(1, p[1])) * dims[0] + bin(0, p[0]);
+      for (uint32_t i = first[cell_bin]; i < first[cell_bin + 1] && !in; ++i) {
+        const auto& [g, r] = overlaps[items[i]];
+        in = g == f && p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] &&
+             p[2] >= r[2] && p[2] <= r[5];
+      }
+      l.boundary[c] = in;
+    }
+  });
 }
 
 // A new fragment starts from the rotation of the fragment it came from (no jump): l.fragment_of
@@ -125,7 +177,7 @@ uint32_t crack_lens(FragmentLens& l, std::span<const std::pair<uint32_t, uint32_
   if (broken == 0) return 0;
   l.awake = true;
   l.fragment_of = l.fragments.label;
-  simplex::label_fragments_painting(l.cells, l.fragments, l.fragment_scratch);
+  simplex::label_fragments_union_find(l.cells, l.fragments, l.fragment_scratch);
   carry_rotations(l);
   l.links_broken += broken;
   ++l.cracks;
@@ -151,7 +203,6 @@ void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   std::fill(l.pushed.begin(), l.pushed.end(), uint8_t{0});
   if (l.fragments.count < 2) return;  // one body: no fragment contact to compute
   mark_boundary(l);
-  const uint32_t n = l.cells.size();
   std::fill(l.fx.begin(), l.fx.end(), 0.0f);
   std::fill(l.fy.begin(), l.fy.end(), 0.0f);
   std::fill(l.fz.begin(), l.fz.end(), 0.0f);
@@ -164,7 +215,8 @@ void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   if (cs.pairs == 0) return;
   const float max_move = 0.5f * l.settings.contact.h, inv_dt = static_cast<float>(1.0 / dt_s);
   const float dt2 = static_cast<float>(dt_s * dt_s);
-  for (uint32_t c = 0; c < n; ++c) {
+  // Only the cells in the contact grid can carry a force (ascending, as a walk over all cells).
+  for (const uint32_t c : l.contact_scratch.members) {
     if (!l.cells.alive[c] || l.cells.mass[c] <= 0) continue;
     if (l.fx[c] == 0.0f && l.fy[c] == 0.0f && l.fz[c] == 0.0f) continue;
     if (l.fragments.label[c] == l.held_fragment) continue;  // the tip carries it: others give way
@@ -208,23 +260,26 @@ constexpr double kRestOverlapMm = 0.35;
 // along the way to their projection (lens_tools::constrain on the one cell).
 void leash_to_bag(FragmentLens& l, double leash_mm) {
   const lens_tools::EyeBounds& b = l.settings.bounds;
-  for (uint32_t c = 0; c < l.cells.size(); ++c) {
-    if (!l.cells.alive[c]) continue;
-    const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
-    if (lens_tools::inside_bounds(p, b, leash_mm)) continue;
-    float x = l.cells.x[c], y = l.cells.y[c], z = l.cells.z[c], vx = 0, vy = 0, vz = 0;
-    const float mass = l.cells.mass[c], hardness = 0;
-    const uint8_t alive = 1;
-    const CellSpans one{{&x, 1},  {&y, 1},    {&z, 1},     {&vx, 1},      {&vy, 1},
-                        {&vz, 1}, {&mass, 1}, {&alive, 1}, {&hardness, 1}};
-    lens_tools::constrain(one, b, {});
-    const Vec3 q(x, y, z), out = p - q;
-    const double len = out.norm();
-    if (!(len > leash_mm)) continue;
-    const Vec3 r = q + out * (leash_mm / len);
-    l.cells.x[c] = static_cast<float>(r.x()), l.cells.y[c] = static_cast<float>(r.y()),
-    l.cells.z[c] = static_cast<float>(r.z());
-  }
+  const lens_tools::SurelyInside sure(b, leash_mm);
+  parallel_for(0, l.cells.size(), kCellGrain, [&](uint32_t cb, uint32_t ce, int) {
+    for (uint32_t c = cb; c < ce; ++c) {
+      if (!l.cells.alive[c] || sure(l.cells.x[c], l.cells.y[c], l.cells.z[c])) continue;
+      const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+      if (lens_tools::inside_bounds(p, b, leash_mm)) continue;
+      float x = l.cells.x[c], y = l.cells.y[c], z = l.cells.z[c], vx = 0, vy = 0, vz = 0;
+      const float mass = l.cells.mass[c], hardness = 0;
+      const uint8_t alive = 1;
+      const CellSpans one{{&x, 1},  {&y, 1},    {&z, 1},     {&vx, 1},      {&vy, 1},
+                          {&vz, 1}, {&mass, 1}, {&alive, 1}, {&hardness, 1}};
+      lens_tools::constrain(one, b, {});
+      const Vec3 q(x, y, z), out = p - q;
+      const double len = out.norm();
+      if (!(len > leash_mm)) continue;
+      const Vec3 r = q + out * (leash_mm / len);
+      l.cells.x[c] = static_cast<float>(r.x()), l.cells.y[c] = static_cast<float>(r.y()),
+      l.cells.z[c] = static_cast<float>(r.z());
+    }
+  });
 }
 
 // Ultrasound on a held fragment: the vacuum draws it into the port as fast as the tip emulsifies
@@ -246,15 +301,18 @@ void feed_held(FragmentLens& l, const Vec3& port, double power, double dt_s) {
   const auto taken = [&](uint32_t c) {
     return std::find(l.removed.begin(), l.removed.end(), c) != l.removed.end();
   };
-  for (int guard = 0; guard < 64; ++guard) {
-    uint32_t best = kNoSimplex;
-    float best_d = std::numeric_limits<float>::infinity();
-    for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
-      const uint32_t c = l.fragments.members[k];
-      const float d = (Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - p).squaredNorm();
-      if (d < best_d && !taken(c)) best_d = d, best = c;
-    }
-    if (best == kNoSimplex || best_d > reach * reach) break;  // only what is at the port
+  // The fragment's cells within reach not yet taken, nearest first (ties: lower id, as a walk
+  // over the members in id order keeping the first of equals): one pass, then in order.
+  auto& near = l.feed_candidates;
+  near.clear();
+  for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
+    const uint32_t c = l.fragments.members[k];
+    const float d = (Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - p).squaredNorm();
+    if (d <= reach * reach && !taken(c)) near.emplace_back(d, c);
+  }
+  std::sort(near.begin(), near.end());
+  for (size_t i = 0; i < near.size() && i < 64; ++i) {
+    const uint32_t best = near[i].second;
     const double cost = l.cells.volume[best] / std::max(1e-3, 1.0 - double(l.hardness[best]));
     if (cost > l.feed_budget_mm3) break;
     l.feed_budget_mm3 -= cost;
@@ -378,14 +436,16 @@ FragmentLensStats step_fragment_lens(FragmentLens& l, const LensTools& tools, co
                                        std::pow(l.settings.fluid.port_radius_mm, 3)
                                  : std::numeric_limits<double>::infinity();
     const uint32_t before = static_cast<uint32_t>(l.removed.size());
-    for (uint32_t c = 0; c < l.cells.size(); ++c) {
-      if (!l.cells.alive[c]) continue;
-      const Vec3f d = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - port;
-      if (d.squaredNorm() < r2 && l.fragments.mass[l.fragments.label[c]] <= passes_kg &&
-          !std::binary_search(l.removed.begin(), l.removed.begin() + before, c)) {
-        l.removed.push_back(c);
-        l.aspirated_mass_kg += l.cells.mass[c];
-      }
+    lens_tools::detail::collect_ids(
+        l.cells.size(), l.scan_ids, l.scan_counts, l.scan_hits, [&](uint32_t c) {
+          if (!l.cells.alive[c]) return false;
+          const Vec3f d = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - port;
+          return d.squaredNorm() < r2 && l.fragments.mass[l.fragments.label[c]] <= passes_kg &&
+                 !std::binary_search(l.removed.begin(), l.removed.begin() + before, c);
+        });
+    for (const uint32_t c : l.scan_hits) {  // in id order, as the masses were always summed
+      l.removed.push_back(c);
+      l.aspirated_mass_kg += l.cells.mass[c];
     }
     st.aspirated = static_cast<uint32_t>(l.removed.size()) - before;
     l.cells_aspirated += st.aspirated;

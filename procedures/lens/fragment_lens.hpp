@@ -112,7 +112,8 @@ struct FragmentLens {
   std::vector<float> fx, fy, fz;
   std::vector<uint8_t> boundary;  // per cell: takes part in fragment contact this step
   std::vector<std::array<float, 6>> fragment_box;  // contact regions (fragment_lens.cpp)
-  std::vector<uint32_t> fragment_order, fragment_first_overlap;
+  std::vector<uint32_t> fragment_order;
+  std::vector<uint32_t> region_bin_first, region_bin_items, region_bin_fill;  // regions by bin
   std::vector<std::pair<uint32_t, std::array<float, 6>>> overlaps;
   std::vector<uint8_t> pushed;  // per cell: fragment contact moved it this step
   std::vector<uint32_t> fragment_of;
@@ -120,6 +121,8 @@ struct FragmentLens {
   lens_tools::ErosionScratch erosion;
   std::vector<uint32_t> removed;
   std::vector<simplex::Removal> removals;
+  std::vector<uint32_t> scan_ids, scan_counts, scan_hits;   // parallel scans' scratch (collect_ids)
+  std::vector<std::pair<float, uint32_t>> feed_candidates;  // (squared distance, cell)
   bool awake = false;
   // Fluidics and cracking (with settings.fluidics).
   double vacuum_mmhg = 0;

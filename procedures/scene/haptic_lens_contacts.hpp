@@ -55,6 +55,10 @@ struct HapticLensScratch {
   // the nearest surface tets starts, and its margin. Found once per lens.
   double mean_radius_mm = 0.0;
   uint32_t tets_of = 0;
+  // The largest equal-volume radius (mm) of the fragment lens's `cells_of` cells (their volumes
+  // never change): a cell farther from the tip than the reach plus this has no sphere within it.
+  double max_cell_radius_mm = 0.0;
+  uint32_t cells_of = 0;
 };
 
 HapticLensSettings haptic_lens_settings(const Scene& scene);

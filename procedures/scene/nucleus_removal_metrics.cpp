@@ -74,17 +74,17 @@ uint32_t sample_nucleus_removal(Scene& scene, NucleusRemovalRecord& r, double dt
   const lens::FragmentLens& l = lf->lens;
   const uint32_t nf = l.fragments.count;
   r.fx.assign(nf, 0.0), r.fy.assign(nf, 0.0), r.fz.assign(nf, 0.0);
-  for (uint32_t c = 0; c < l.cells.size(); ++c) {
-    if (!l.cells.alive[c]) continue;
-    const uint32_t f = l.fragments.label[c];
-    const double m = l.cells.mass[c];
-    r.fx[f] += m * l.cells.x[c], r.fy[f] += m * l.cells.y[c], r.fz[f] += m * l.cells.z[c];
-  }
   uint32_t out = 0;
   const auto& ant = r.bounds.anterior_capsule;
   for (uint32_t f = 0; f < nf; ++f) {
     const double m = l.fragments.mass[f];
     if (f == l.held_fragment || m < kPieceMassFraction * l.initial_mass_kg) continue;
+    // The pieces' centres only, over their members (alive, ascending ids).
+    for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
+      const uint32_t c = l.fragments.members[k];
+      const double mc = l.cells.mass[c];
+      r.fx[f] += mc * l.cells.x[c], r.fy[f] += mc * l.cells.y[c], r.fz[f] += mc * l.cells.z[c];
+    }
     const Vec3 c(r.fx[f] / m, r.fy[f] / m, r.fz[f] / m);
     out += (c - ant.centre).norm() > ant.radius_mm;
   }

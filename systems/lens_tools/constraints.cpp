@@ -100,6 +100,23 @@ bool inside_bounds(const Vec3& p, const EyeBounds& bounds, double tolerance_mm) 
          in_ball(p, bounds.cornea, tolerance_mm);
 }
 
+SurelyInside::SurelyInside(const EyeBounds& bounds, double tolerance_mm) {
+  auto ball = [&](const Ball& b) {
+    FloatBall f;
+    f.present = present(b);
+    if (!f.present) return f;
+    f.cx = static_cast<float>(b.centre.x()), f.cy = static_cast<float>(b.centre.y()),
+    f.cz = static_cast<float>(b.centre.z());
+    const float r = static_cast<float>(std::max(b.radius_mm + tolerance_mm - kFastMarginMm, 0.0));
+    f.r2 = r * r;
+    return f;
+  };
+  cornea = ball(bounds.cornea), anterior = ball(bounds.anterior_capsule),
+  posterior = ball(bounds.posterior_capsule);
+  const double open = bounds.rhexis_radius_mm - kFastMarginMm;
+  if (bounds.rhexis_radius_mm > 0 && open > 0) open2 = static_cast<float>(open * open);
+}
+
 namespace {
 
 // A float ball a little smaller than the real one (by kFastMarginMm): a cell inside it is surely

@@ -74,6 +74,29 @@ Vec3 project_into(const Vec3& p, const Ball& a, const Ball& b, double skin_mm);
 // Is p inside the set constrain() enforces (cell at radius r from the optical axis)?
 bool inside_bounds(const Vec3& p, const EyeBounds& bounds, double tolerance_mm);
 
+// A float pre-test for inside_bounds(p, bounds, tolerance_mm): true only where that is surely
+// true (each ball taken 1e-4 mm smaller than the exact test's, far above float rounding at eye
+// scale), so a caller that asks inside_bounds only where this says false decides every point as
+// inside_bounds alone would.
+struct SurelyInside {
+  SurelyInside(const EyeBounds& bounds, double tolerance_mm);
+  bool operator()(float x, float y, float z) const {
+    const bool open = open2 >= 0 && x * x + y * y < open2;
+    return (open || in(anterior, x, y, z)) && in(posterior, x, y, z) && in(cornea, x, y, z);
+  }
+
+  struct FloatBall {
+    float cx = 0, cy = 0, cz = 0, r2 = 0;
+    bool present = false;
+  };
+  static bool in(const FloatBall& b, float x, float y, float z) {
+    const float dx = x - b.cx, dy = y - b.cy, dz = z - b.cz;
+    return !b.present || dx * dx + dy * dy + dz * dz <= b.r2;
+  }
+  FloatBall cornea, anterior, posterior;
+  float open2 = -1;  // (rhexis radius − margin)², < 0 without an opening
+};
+
 // Projects every alive cell into the bounds and removes the outward velocity of moved cells.
 // `contact` (empty, or one entry per cell) is set to 1 for moved cells and 0 for the others.
 void constrain(const CellSpans& cells, const EyeBounds& bounds, std::span<uint8_t> contact);

@@ -6,12 +6,14 @@
 #include <limits>
 
 #include "engine/core/invariants.hpp"
+#include "engine/schedule/parallel.hpp"
 
 namespace phaco::lens_tools {
 
 namespace {
 
 constexpr uint32_t kNone = 0xffffffffu;
+constexpr uint32_t kGrain = 8192;  // cells per chunk of the nearest-cell scan
 
 struct Nearest {
   uint32_t cell = kNone;
@@ -26,17 +28,36 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
   CrackPush out;
   const Vec3f p = probe_tip.cast<float>(), q = chopper_tip.cast<float>();
   const Vec3f m = 0.5f * (p + q);
-  Nearest np, nq;
-  float gap2 = std::numeric_limits<float>::infinity();
+  // Nearest cells to each tip (the lowest id among equals) and to the midpoint, over fixed chunks
+  // merged in id order: the same cells as one walk in id order, for any thread count.
+  struct Scan {
+    Nearest np, nq;
+    float gap2 = std::numeric_limits<float>::infinity();
+  };
   const uint32_t n = static_cast<uint32_t>(c.x.size());
-  for (uint32_t i = 0; i < n; ++i) {
-    if (!c.alive[i]) continue;
-    const Vec3f x(c.x[i], c.y[i], c.z[i]);
-    const float dp = (x - p).squaredNorm(), dq = (x - q).squaredNorm(), dm = (x - m).squaredNorm();
-    if (dp < np.d2) np = {i, dp};
-    if (dq < nq.d2) nq = {i, dq};
-    gap2 = std::min(gap2, dm);
-  }
+  const Scan scan = parallel_reduce_ordered(
+      0u, n, kGrain, Scan{},
+      [&](uint32_t b, uint32_t e) {
+        Scan s;
+        for (uint32_t i = b; i < e; ++i) {
+          if (!c.alive[i]) continue;
+          const Vec3f x(c.x[i], c.y[i], c.z[i]);
+          const float dp = (x - p).squaredNorm(), dq = (x - q).squaredNorm(),
+                      dm = (x - m).squaredNorm();
+          if (dp < s.np.d2) s.np = {i, dp};
+          if (dq < s.nq.d2) s.nq = {i, dq};
+          s.gap2 = std::min(s.gap2, dm);
+        }
+        return s;
+      },
+      [](Scan a, const Scan& b) {
+        if (b.np.d2 < a.np.d2) a.np = b.np;
+        if (b.nq.d2 < a.nq.d2) a.nq = b.nq;
+        a.gap2 = std::min(a.gap2, b.gap2);
+        return a;
+      });
+  const Nearest np = scan.np, nq = scan.nq;
+  const float gap2 = scan.gap2;
   const float contact2 = static_cast<float>(s.contact_radius_mm * s.contact_radius_mm);
   const float gap_r2 = static_cast<float>(s.gap_radius_mm * s.gap_radius_mm);
   const bool touching = np.cell != kNone && nq.cell != kNone && np.d2 <= contact2 &&

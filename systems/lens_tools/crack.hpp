@@ -20,7 +20,8 @@
 //   - the trench between them: no alive cell within gap_radius_mm of their midpoint;
 //   - the spread growing: d > 0 measured from the smallest separation while engaged (moving the
 //     tips together re-arms the spring; letting go of the fragment disengages).
-// Deterministic: one pass over the cells in id order.
+// Deterministic: the nearest cells are those of one pass in id order (a parallel scan over fixed
+// chunks, merged in id order), for any thread count.
 //
 // Reads: cells (x, y, z, alive, hardness), fragment labels, neighbour links, the two tips.
 // Writes: CrackState, the list of links to break (the caller applies them at its sync point).

@@ -199,7 +199,9 @@ FragmentUpdate update_fragments(const SimplexCells& cells, std::span<const Remov
     }
   }
   if (may_split) {
-    label_fragments_painting(cells, frags, scratch);
+    // The parallel labelling: the same table as painting's (the header says why), sooner on a
+    // large lens.
+    label_fragments_union_find(cells, frags, scratch);
     result.relabelled = true;
     result.fragments = frags.count;
     return result;

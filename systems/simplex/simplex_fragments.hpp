@@ -55,7 +55,7 @@ void label_fragments_union_find(const SimplexCells& cells, Fragments& out, Fragm
                                 uint32_t grain = 4096);
 
 struct FragmentUpdate {
-  bool relabelled = false;  // a removal could split: labelled again by painting
+  bool relabelled = false;  // a removal could split: labelled again (union-find, in parallel)
   uint32_t fragments = 0;   // fragments after the update
 };
 

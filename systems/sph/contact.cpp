@@ -1,5 +1,6 @@
 #include "systems/sph/contact.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -13,6 +14,7 @@ namespace phaco::sph {
 namespace {
 
 constexpr uint32_t kGrain = 256;
+constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the mixed-cell passes
 
 // ∫ u(1 − u²)² du = −(1 − u²)³/6, normalised by the peak u_p(1 − u_p²)², u_p = 1/√5; below
 // u_p the shape is 1.
@@ -22,6 +24,39 @@ double shape_integral(double from) {
   const double a = std::max(from, up);
   const double tail = std::pow(1.0 - a * a, 3) / 6.0 / peak;  // ∫_a^1
   return tail + std::max(0.0, up - from);                     // + ∫_from^up of 1
+}
+
+// Per grid cell (sorted orders): whether its 3×3×3 block of cells (edge 2h, so every pair within
+// h of its particles) holds more than one fragment. Only such cells can have a contact pair.
+void mark_mixed_cells(const Grid& g, std::span<const uint32_t> fragment, ContactScratch& s) {
+  const auto cells = static_cast<uint32_t>(g.cell_key.size());
+  s.cell_lo.resize(cells), s.cell_hi.resize(cells), s.mixed.resize(cells);
+  parallel_for(0, cells, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    for (uint32_t c = b; c < e; ++c) {
+      uint32_t lo = 0xffffffffu, hi = 0;
+      for (uint32_t k = g.cell_begin[c]; k < g.cell_begin[c + 1]; ++k)
+        lo = std::min(lo, fragment[g.id[k]]), hi = std::max(hi, fragment[g.id[k]]);
+      s.cell_lo[c] = lo, s.cell_hi[c] = hi;
+    }
+  });
+  parallel_for(0, cells, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    CellRuns near;
+    for (uint32_t c = b; c < e; ++c) {
+      const uint32_t f = s.cell_lo[c];
+      bool mixed = s.cell_hi[c] != f;
+      cell_neighbourhood(g, c, near);
+      for (int k = 0; k < 27 && !mixed; ++k) {
+        uint32_t other = kNoSlot;
+        if (near.subcells) {
+          other = near.parent[k];
+        } else if (near.block[k].begin != near.block[k].end) {
+          other = g.slot_cell[near.block[k].begin];
+        }
+        mixed = other != kNoSlot && (s.cell_lo[other] != f || s.cell_hi[other] != f);
+      }
+      s.mixed[c] = mixed;
+    }
+  });
 }
 
 }  // namespace
@@ -57,32 +92,48 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
   if (stats.particles < 2) return stats;
   Grid& g = scratch.grid;
   build_grid(g, in.x, in.y, in.z, {}, params.h, params.order, scratch.members);
+  const bool sorted = params.order != CellOrder::UnsortedHash;
+  if (sorted) mark_mixed_cells(g, in.fragment, scratch);
 
   const uint64_t twice = parallel_reduce_ordered(
       0u, g.count, kGrain, uint64_t{0},
       [&](uint32_t b, uint32_t e) {
         uint64_t pairs = 0;
         float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-        for_each_neighbour(
-            g, b, e,
-            [&](uint32_t i, uint32_t j, float dx, float dy, float dz, float r2) {
-              const uint32_t pi = g.id[i], pj = g.id[j];
-              if (in.fragment[pj] == in.fragment[pi]) return;
-              const float vd = (in.vx[pi] - in.vx[pj]) * dx + (in.vy[pi] - in.vy[pj]) * dy +
-                               (in.vz[pi] - in.vz[pj]) * dz;
-              const float s = pair_force_scale(params, r2, vd);
-              sx += s * dx;
-              sy += s * dy;
-              sz += s * dz;
-              ++pairs;
-            },
-            [&](uint32_t i) {
-              const uint32_t pi = g.id[i];
-              fx[pi] += sx;
-              fy[pi] += sy;
-              fz[pi] += sz;
-              sx = sy = sz = 0.0f;
-            });
+        auto pass = [&](uint32_t from, uint32_t to) {
+          for_each_neighbour(
+              g, from, to,
+              [&](uint32_t i, uint32_t j, float dx, float dy, float dz, float r2) {
+                const uint32_t pi = g.id[i], pj = g.id[j];
+                if (in.fragment[pj] == in.fragment[pi]) return;
+                const float vd = (in.vx[pi] - in.vx[pj]) * dx + (in.vy[pi] - in.vy[pj]) * dy +
+                                 (in.vz[pi] - in.vz[pj]) * dz;
+                const float s = pair_force_scale(params, r2, vd);
+                sx += s * dx;
+                sy += s * dy;
+                sz += s * dz;
+                ++pairs;
+              },
+              [&](uint32_t i) {
+                const uint32_t pi = g.id[i];
+                fx[pi] += sx;
+                fy[pi] += sy;
+                fz[pi] += sz;
+                sx = sy = sz = 0.0f;
+              });
+        };
+        if (!sorted) {
+          pass(b, e);
+          return pairs;
+        }
+        // Slots of one cell at a time; a cell whose neighbourhood holds one fragment only has no
+        // pair to sum (its slots would add +0 to their forces): skipped.
+        for (uint32_t s = b; s < e;) {
+          const uint32_t cell = g.slot_cell[s];
+          const uint32_t to = std::min(e, g.cell_begin[cell + 1]);
+          if (scratch.mixed[cell]) pass(s, to);
+          s = to;
+        }
         return pairs;
       },
       [](uint64_t a, uint64_t b) { return a + b; });

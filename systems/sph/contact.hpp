@@ -21,7 +21,9 @@
 // total momentum changes only by the rounding of those per-particle sums.
 //
 // Scope (DESIGN §3: model no more than the scene needs): with fewer than two fragments the call
-// returns at once; otherwise only particles flagged boundary enter the grid.
+// returns at once; otherwise only particles flagged boundary enter the grid, and only the grid
+// cells whose 3×3×3 block of cells (edge 2h) holds two fragments or more are scanned (a particle
+// elsewhere has no pair: skipping it adds nothing, so the forces are the same bits).
 //
 // Reads: positions, velocities, fragment labels, boundary flags. Writes: forces (added, mN).
 #include <cstdint>
@@ -48,7 +50,9 @@ struct ContactParticles {
 
 struct ContactScratch {
   Grid grid;
-  std::vector<uint32_t> members;  // boundary particles
+  std::vector<uint32_t> members;           // boundary particles
+  std::vector<uint32_t> cell_lo, cell_hi;  // per grid cell: smallest and largest fragment in it
+  std::vector<uint8_t> mixed;              // per grid cell: another fragment in its 3×3×3 block
 };
 
 struct ContactStats {
