@@ -89,7 +89,8 @@ studies:
   trainer
       Issue 8, phaco-trainer under Xvfb on Mesa's software renderer at 1280x720, each drill with
       scripted hands: render frame rate and frame times, simulation rate and haptic period, with
-      and without rendering. About 2 minutes (quick 30 s). Needs xvfb-run.
+      and without rendering; then issue 20's scripted expert procedure (phaco-trainer --procedure)
+      from start to end, with and without rendering. About 8 minutes (quick 2). Needs xvfb-run.
   sweep [--max-level L] [--drill NAME]... [--replot]
   sweep --reference [--drill NAME]... [--reference-level L] [--reference-dt-divisor K]
       Issues 9 and 17, the whole trainer under load: each drill's scripted expert run to its end

@@ -3,7 +3,8 @@
 // loop: the render frame rate and frame times, and beside them the simulation rate and the haptic
 // period — once rendering, once with the same loop drawing nothing (--no-render), to show that
 // rendering does not slow the simulation or the haptic thread (DESIGN.md §5). The trainer runs as
-// its own process, exactly as a trainee starts it; it writes its figures with --stats.
+// its own process, exactly as a trainee starts it; it writes its figures with --stats. Then the
+// scripted expert's whole procedure (issue 20, phaco-trainer --procedure), render on and off.
 #include <unistd.h>
 
 #include <array>
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,7 @@
 #include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
+#include "procedures/eye/eye_params.hpp"
 
 namespace phaco::perf {
 namespace {
@@ -39,35 +42,133 @@ fs::path trainer_binary() {
   return bin;
 }
 
+std::string met(bool ok) {
+  return ok ? "met" : "**missed**";
+}
+
 struct TrainerRun {
-  std::string drill;
+  std::string drill;  // or "procedure"
   bool render = true;
   nlohmann::json stats;
+  double load_before = -1, load_after = -1;  // 1-min load average: the machine may be shared
 };
 
-TrainerRun run_trainer(const fs::path& bin, const fs::path& dir, const std::string& drill,
-                       bool render, double seconds) {
-  const fs::path out = dir / ("trainer_" + drill + (render ? "" : "_norender") + ".stats.json");
+double load_1min() {
+  std::ifstream in("/proc/loadavg");
+  double one = -1;
+  return in >> one ? one : -1.0;
+}
+
+// "name on/off before → after, ..." for the runs.
+std::string loads(const std::vector<const TrainerRun*>& runs) {
+  std::string out;
+  for (const TrainerRun* r : runs) {
+    out += (out.empty() ? "" : ", ") + r->drill + (r->render ? "" : " (render off)") + " " +
+           fmt("%.1f", r->load_before) + " → " + fmt("%.1f", r->load_after);
+  }
+  return out;
+}
+
+// `what`: "--drill NAME" or "--procedure FILE"; `tail`: how long (and any other options).
+TrainerRun run_trainer(const fs::path& bin, const fs::path& dir, const std::string& name,
+                       const std::string& what, const std::string& tail, bool render) {
+  const fs::path out = dir / ("trainer_" + name + (render ? "" : "_norender") + ".stats.json");
   fs::remove(out);
-  // The drill runs longer than the measurement: the scripted hands hold their last pose.
   const std::string cmd = "xvfb-run -a -s '-screen 0 " + std::to_string(kWidth) + "x" +
-                          std::to_string(kHeight) + "x24' " + bin.string() + " --drill " + drill +
-                          " --left scripted --right scripted --duration " +
-                          std::to_string(seconds + 30) + " --size " + std::to_string(kWidth) + "x" +
-                          std::to_string(kHeight) + " --stats " + out.string() + " --stats-after " +
-                          std::to_string(seconds) + (render ? "" : " --no-render") +
-                          " > /dev/null 2>&1";
+                          std::to_string(kHeight) + "x24' " + bin.string() + " " + what +
+                          " --left scripted --right scripted --size " + std::to_string(kWidth) +
+                          "x" + std::to_string(kHeight) + " --stats " + out.string() + " " + tail +
+                          (render ? "" : " --no-render") + " > /dev/null 2>&1";
+  const double before = load_1min();
   const int rc = std::system(cmd.c_str());
+  const double after = load_1min();
   if (rc != 0 || !fs::exists(out)) {
     throw InputError("trainer: `" + cmd + "` failed (exit " + std::to_string(rc) +
                      "); is xvfb-run installed (scripts/install-deps.sh)?");
   }
   std::ifstream in(out);
-  return {drill, render, nlohmann::json::parse(in)};
+  return {name, render, nlohmann::json::parse(in), before, after};
 }
 
-std::string met(bool ok) {
-  return ok ? "met" : "**missed**";
+TrainerRun run_drill(const fs::path& bin, const fs::path& dir, const std::string& drill,
+                     bool render, double seconds) {
+  // The drill runs longer than the measurement: the scripted hands hold their last pose.
+  return run_trainer(
+      bin, dir, drill, "--drill " + drill,
+      "--duration " + std::to_string(seconds + 30) + " --stats-after " + std::to_string(seconds),
+      render);
+}
+
+// The scripted expert's procedure (issue 20): every step, each on the eye the steps before it
+// left; the trainer writes its figures when the procedure closes (--quick: after `quick_s`).
+TrainerRun run_procedure(const fs::path& bin, const fs::path& dir, const fs::path& file,
+                         bool render, std::optional<double> quick_s) {
+  const std::string after = quick_s ? std::to_string(*quick_s) : std::string("3600");
+  return run_trainer(bin, dir, "procedure", "--procedure " + file.string(),
+                     "--stats-after " + after + " --timeout 3600", render);
+}
+
+// The procedure's section: the whole run's figures, then each step's (render on).
+std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const fs::path& file,
+                              bool quick) {
+  const auto& a = on.stats;
+  const auto& b = off.stats;
+  std::string md =
+      "### The whole procedure (issue 20)\n\n`phaco-trainer --procedure " +
+      file.filename().string() +
+      "` (the scripted expert's four steps in one eye, at the procedure file's eye "
+      "level; both hands on scripted devices) under the same Xvfb, " +
+      (quick ? std::string("the first ") + fmt("%.0f", a.value("wall_s", 0.0)) + " s (--quick)"
+             : std::string("from its start to its end")) +
+      "; the haptic loop and the frame count restart with each step, so the "
+      "procedure's haptic period is its worst step's and its simulation rate the "
+      "steps' frames over the whole wall time (step changes included). Targets: "
+      "30 fps, haptic period p99 ≤ 1020 us.\n\n";
+  md +=
+      "| run | fps | frame p50 / p99 ms | target 30 fps | simulation Hz | haptic period p50 / "
+      "p99 us | target p99 ≤ 1020 us | wall s |\n|---|---|---|---|---|---|---|---|\n";
+  for (const TrainerRun* r : {&on, &off}) {
+    const auto& s = r->stats;
+    const double f = s.value("fps", 0.0);
+    const double p99 = s.value("haptic_period_p99_us", 0.0);
+    md += std::string("| ") + (r->render ? "render on" : "render off") + " | " +
+          (r->render ? fmt("%.1f", f) : std::string("—")) + " | " +
+          (r->render ? fmt("%.1f", s.value("frame_p50_ms", 0.0)) + " / " +
+                           fmt("%.1f", s.value("frame_p99_ms", 0.0))
+                     : std::string("—")) +
+          " | " + (r->render ? met(f >= kTargetFps) : std::string("—")) + " | " +
+          fmt("%.1f", s.value("sim_rate_hz", 0.0)) + " | " +
+          fmt("%.0f", s.value("haptic_period_p50_us", 0.0)) + " / " + fmt("%.0f", p99) + " | " +
+          met(p99 <= 1020.0) + " | " + fmt("%.0f", s.value("wall_s", 0.0)) + " |\n";
+  }
+  md +=
+      "\n| step | fps (render on) | wall s | simulated s | simulation Hz | haptic period p50 / "
+      "p99 us, render on (off) |\n|---|---|---|---|---|---|\n";
+  const auto steps_a = a.value("steps", nlohmann::json::array());
+  const auto steps_b = b.value("steps", nlohmann::json::array());
+  for (size_t i = 0; i < steps_a.size(); ++i) {
+    const auto& s = steps_a[i];
+    const double wall = s.value("wall_s", 0.0);
+    md += "| " + s.value("drill", std::string("?")) + " | " + fmt("%.1f", s.value("fps", 0.0)) +
+          " | " + fmt("%.0f", wall) + " | " + fmt("%.1f", s.value("sim_time_s", 0.0)) + " | " +
+          fmt("%.1f", wall > 0 ? s.value("sim_frames", 0.0) / wall : 0.0) + " | " +
+          fmt("%.0f", s.value("haptic_period_p50_us", 0.0)) + " / " +
+          fmt("%.0f", s.value("haptic_period_p99_us", 0.0));
+    if (i < steps_b.size())
+      md += " (" + fmt("%.0f", steps_b[i].value("haptic_period_p50_us", 0.0)) + " / " +
+            fmt("%.0f", steps_b[i].value("haptic_period_p99_us", 0.0)) + ")";
+    md += " |\n";
+  }
+  return md + "\n";
+}
+
+void add_row(Table& t, const TrainerRun& r) {
+  const auto& s = r.stats;
+  t.add({r.drill, r.render ? "on" : "off", s.value("renderer", std::string("?")),
+         s.value("fps", 0.0), s.value("frame_p50_ms", 0.0), s.value("frame_p99_ms", 0.0),
+         s.value("sim_rate_hz", 0.0), s.value("haptic_period_p50_us", 0.0),
+         s.value("haptic_period_p99_us", 0.0), s.value("haptic_ticks", 0.0),
+         s.value("snapshots_published", 0.0), s.value("wall_s", 0.0)});
 }
 
 }  // namespace
@@ -80,13 +181,20 @@ void run_trainer_study(const StudyOptions& options) {
   const double seconds = options.quick ? 5 : 20;
   const std::array<std::string, 3> drills = {"capsulorhexis", "phaco_sculpting",
                                              "corneal_incision"};
-  Progress progress(static_cast<int>(drills.size()) * 2 + 1);
+  Progress progress(static_cast<int>(drills.size()) * 2 + 3);
   std::vector<TrainerRun> runs;
   for (const auto& d : drills) {
     for (bool render : {true, false}) {
       progress.step("trainer: " + d + (render ? "" : " (no render)"));
-      runs.push_back(run_trainer(bin, dir, d, render, seconds));
+      runs.push_back(run_drill(bin, dir, d, render, seconds));
     }
+  }
+  const fs::path procedure = eye::data_dir() / "procedures" / "cataract_expert.json";
+  std::array<TrainerRun, 2> procedure_runs;
+  for (bool render : {true, false}) {
+    progress.step(std::string("trainer: the expert procedure") + (render ? "" : " (no render)"));
+    procedure_runs[render ? 0 : 1] = run_procedure(
+        bin, dir, procedure, render, options.quick ? std::optional<double>(30) : std::nullopt);
   }
   progress.step("trainer: writing");
 
@@ -138,19 +246,23 @@ void run_trainer_study(const StudyOptions& options) {
     sim.x.push_back(x), sim.y.push_back(on.value("sim_rate_hz", 0.0));
     sim_off.x.push_back(x), sim_off.y.push_back(off.value("sim_rate_hz", 0.0));
     for (const TrainerRun* r : {&runs[i], &runs[i + 1]}) {
-      const auto& s = r->stats;
-      t.add({r->drill, r->render ? "on" : "off", s.value("renderer", std::string("?")),
-             s.value("fps", 0.0), s.value("frame_p50_ms", 0.0), s.value("frame_p99_ms", 0.0),
-             s.value("sim_rate_hz", 0.0), s.value("haptic_period_p50_us", 0.0),
-             s.value("haptic_period_p99_us", 0.0), s.value("haptic_ticks", 0.0),
-             s.value("snapshots_published", 0.0), s.value("wall_s", 0.0)});
+      add_row(t, *r);
     }
   }
+  for (const TrainerRun& r : procedure_runs) add_row(t, r);
   chart.series = {fps, sim, sim_off};
   save_chart(chart, dir / "trainer_rates.png");
   write_csv(t, dir / "trainer.csv");
   write_json(t, dir / "trainer.json");
   md += "\n![trainer rates](results/trainer_rates.png)\n\n";
+  md += procedure_section(procedure_runs[0], procedure_runs[1], procedure, options.quick);
+  std::vector<const TrainerRun*> all;
+  for (const TrainerRun& r : runs) all.push_back(&r);
+  for (const TrainerRun& r : procedure_runs) all.push_back(&r);
+  md +=
+      "1-min load average before → after each run (above 2, other processes shared the 2 cores "
+      "with the trainer): " +
+      loads(all) + ".\n\n";
   write_section(dir, "trainer", md);
   progress.finish();
 }

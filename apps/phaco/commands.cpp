@@ -202,6 +202,16 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
   return kOk;
 }
 
+std::optional<std::filesystem::path> record_target(const Args& a) {
+  const auto trainee = a.option("--trainee");
+  if (!a.option("--record") && !trainee) return std::nullopt;
+  if (!trainee) throw InputError("run: --record needs --trainee NAME");
+  const std::filesystem::path db =
+      a.option("--record") ? std::filesystem::path(*a.option("--record")) : default_records_db();
+  check_record_target(db, *trainee);
+  return db;
+}
+
 int run(const std::vector<std::string>& raw) {
   const Args a =
       parse_args("run", raw,
@@ -220,13 +230,8 @@ int run(const std::vector<std::string>& raw) {
   }
   if (a.flag("--no-rt")) throw InputError("run: --no-rt needs --haptics");
   // Records (issue 7, docs/records.md): checked before the drill, stored after it.
-  std::optional<std::filesystem::path> db;
+  const std::optional<std::filesystem::path> db = record_target(a);
   const auto trainee = a.option("--trainee");
-  if (a.option("--record") || trainee) {
-    if (!trainee) throw InputError("run: --record needs --trainee NAME");
-    db = a.option("--record") ? std::filesystem::path(*a.option("--record")) : default_records_db();
-    check_record_target(*db, *trainee);
-  }
   const RunReport report = run_scenario(scenario, scene_options(a, "run"));
   nlohmann::json j = to_json(report);
   j["date"] = utc_now();  // when the run finished, for the HTML report and the records

@@ -1,7 +1,9 @@
 #pragma once
 // The headless `phaco` command: one function per subcommand. Each returns the process exit code:
 // 0 success, 2 bad input (message on stderr), 1 internal error.
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,5 +21,8 @@ int graph(const std::vector<std::string>& args);
 struct Args;
 // `run`'s output: the JSON report with --json, else the summary and where --report wrote it.
 void print_run(const Args& a, const nlohmann::json& report, const std::string& summary);
+// `run`'s records (docs/records.md): the database --record/--trainee name, checked before the run
+// (the trainee's name acceptable, the database opening); none without either. Throws InputError.
+std::optional<std::filesystem::path> record_target(const Args& a);
 
 }  // namespace phaco::cli

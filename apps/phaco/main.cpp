@@ -29,10 +29,12 @@ usage:
       --difficulty picks a level of the drill file (drills/<drill>.json in the data folder,
       e.g. standard, easy, hard; docs/drills.md) instead of the scenario's.
   phaco run PROCEDURE.json [--threads N] [--report OUT.json] [--json] [--difficulty LEVEL]
+                           [--record DB --trainee NAME]
       A procedure (a file with "steps", e.g. procedures/cataract_expert.json in the data folder;
       docs/procedures.md): its drills one after the other in one eye (the incision cut is the
       main port, the torn rhexis the opening, the sculpted trench the groove), each scored as its
-      drill, and the total; a complication fails the procedure there and says why.
+      drill, and the total; a complication fails the procedure there and says why. With
+      --trainee, each step that ran is stored as its drill's record.
   phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
                  [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
                  [--record DB --trainee NAME]

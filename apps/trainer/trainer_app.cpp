@@ -187,8 +187,48 @@ TrainerConfig config_of(const TrainerOptions& o) {
   return c;
 }
 
+// One procedure step's session as --stats sees it (each step runs in its own session: its own
+// frame count and haptic loop).
+struct StepStatus {
+  std::string drill;
+  TrainerStatus status;
+  size_t render_frames = 0;  // drawn while the step ran
+  double wall_s = 0;         // from the step's start (its scene's build included)
+};
+
+nlohmann::json step_json(const StepStatus& st) {
+  const TrainerStatus& s = st.status;
+  return {{"drill", st.drill},
+          {"wall_s", st.wall_s},
+          {"render_frames", st.render_frames},
+          {"fps", st.wall_s > 0 ? static_cast<double>(st.render_frames) / st.wall_s : 0.0},
+          {"sim_frames", s.frame},
+          {"sim_time_s", s.sim_time_s},
+          {"haptic_period_p50_us", s.haptic_period_p50_us},
+          {"haptic_period_p99_us", s.haptic_period_p99_us},
+          {"haptic_ticks", s.haptic_ticks},
+          {"snapshots_published", s.snapshots_published}};
+}
+
+// `steps`: a procedure's sessions so far, the one in progress last (empty for a drill). Over a
+// procedure the simulation's frames and haptic ticks are the steps' sums and the haptic period's
+// percentiles the worst step's (each step's own are under "steps").
 void write_stats(const std::filesystem::path& file, const TrainerOptions& o, const FrameClock& fc,
-                 const TrainerStatus& s, double wall_s) {
+                 const TrainerStatus& current, double wall_s,
+                 const std::vector<StepStatus>& steps = {}) {
+  TrainerStatus s = current;
+  if (!steps.empty()) {
+    s.frame = 0, s.sim_time_s = 0, s.haptic_ticks = 0, s.snapshots_published = 0;
+    s.haptic_period_p50_us = 0, s.haptic_period_p99_us = 0;
+    for (const StepStatus& st : steps) {
+      s.frame += st.status.frame;
+      s.sim_time_s += st.status.sim_time_s;
+      s.haptic_ticks += st.status.haptic_ticks;
+      s.snapshots_published += st.status.snapshots_published;
+      s.haptic_period_p50_us = std::max(s.haptic_period_p50_us, st.status.haptic_period_p50_us);
+      s.haptic_period_p99_us = std::max(s.haptic_period_p99_us, st.status.haptic_period_p99_us);
+    }
+  }
   nlohmann::json j;
   j["width"] = o.width;
   j["height"] = o.height;
@@ -206,6 +246,10 @@ void write_stats(const std::filesystem::path& file, const TrainerOptions& o, con
   j["haptic_period_p99_us"] = s.haptic_period_p99_us;
   j["haptic_ticks"] = s.haptic_ticks;
   j["snapshots_published"] = s.snapshots_published;
+  if (!steps.empty()) {
+    j["steps"] = nlohmann::json::array();
+    for (const StepStatus& st : steps) j["steps"].push_back(step_json(st));
+  }
   std::ofstream out(file);
   out << j.dump(2) << "\n";
   if (!out) throw InputError(file.string() + ": cannot write the statistics");
@@ -408,13 +452,37 @@ int run_trainer(const TrainerOptions& o) {
     std::string soak_drill(to_string(config.scenario.drill));
     size_t soak_frame0 = 0;
     std::vector<SoakSample> soak_samples;
+    // --procedure: the steps' sessions that are over, for --stats, and where the current began.
+    std::vector<StepStatus> procedure_steps;
+    size_t step_frame0 = 0;
+    double step_wall0 = 0;
+    const auto this_step = [&] {
+      return StepStatus{std::string(to_string(config.scenario.drill)), session->status(),
+                        frames.ms.size() - step_frame0, wall_s() - step_wall0};
+    };
+    const auto steps_so_far = [&] {
+      std::vector<StepStatus> steps = procedure_steps;
+      steps.push_back(this_step());
+      return steps;
+    };
 
     while (!glfwWindowShouldClose(window)) {
       glfwPollEvents();
       // The Result panel finishes a drill that ended (Idle after), unless this loop got there
       // first (Ended): either way the drill is over.
-      if (procedure && procedure->close_when_done()) break;
+      if (procedure && procedure->close_when_done()) {
+        // A scripted procedure ended before --stats-after: its figures are the whole procedure's.
+        if (o.stats) {
+          write_stats(*o.stats, o, frames, session->status(), wall_s(), steps_so_far());
+          std::printf("statistics at the procedure's end, %.1f s: %s\n", wall_s(),
+                      o.stats->c_str());
+        }
+        break;
+      }
       if (procedure && procedure->step_over(*session)) {
+        procedure_steps.push_back(this_step());
+        step_frame0 = frames.ms.size();
+        step_wall0 = wall_s();
         config = procedure->step_config(config);
         restart_session(session, config);
         ui = TrainerUi(o, config);  // the next step's panels, its Result not yet shown
@@ -500,7 +568,8 @@ int run_trainer(const TrainerOptions& o) {
       frames.tick();
 
       if (o.stats && wall_s() >= o.stats_after_s) {
-        write_stats(*o.stats, o, frames, session->status(), wall_s());
+        write_stats(*o.stats, o, frames, session->status(), wall_s(),
+                    procedure ? steps_so_far() : std::vector<StepStatus>{});
         std::printf("statistics after %.1f s: %s\n", wall_s(), o.stats->c_str());
         break;
       }

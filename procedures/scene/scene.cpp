@@ -27,6 +27,7 @@
 #include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/scene_inputs.hpp"
 #include "procedures/scene/tool_ports.hpp"
+#include "procedures/scene/track_pivot.hpp"
 #include "systems/tool_motion/tool_motion.hpp"
 
 namespace phaco {
@@ -274,12 +275,15 @@ std::vector<SystemDesc> base_systems(Scene& scene) {
                          // first pose arrives the tool waits at the track's start, where the
                          // device starts too, rather than following the script for a few
                          // frames and jumping back (issue 24: 0.07 mm on an untouched hand).
+                         const auto& pivot = scene.track_pivots[static_cast<size_t>(hand) & 1u];
                          if (scene.haptics && scene.haptics->drives(hand)) {
                            if (!scene.haptics->newest_pose(hand, pose))
                              tool_motion::move_tool(track, pose, 0.0);
+                           pivot_track_pose(pose, pivot);
                            continue;
                          }
                          tool_motion::move_tool(track, pose, t_end);
+                         pivot_track_pose(pose, pivot);
                        }
                      }});
   // The frame's one sync point for structural change (DESIGN.md §4, step 3).
@@ -371,12 +375,15 @@ std::unique_ptr<Scene> build_scene(const Scenario& scenario, const SceneOptions&
 
   name_base_components(scene->world);
   for (BodyPart part : parts) add_body(*scene, part, meshes);
+  scene->track_pivots = track_pivots(*scene);
   for (const HandTrack& hand : scenario.hands) {
     const Entity e = scene->world.create(EntityKind::Tool, std::string(to_string(hand.hand)) + "." +
                                                                std::string(to_string(hand.tool)));
     scene->world.add(e, Tool{hand.tool, hand.hand});
     scene->world.add(e, ToolTrack{hand.track});
-    scene->world.add(e, sample_track(hand.track, 0.0));
+    ToolState start = sample_track(hand.track, 0.0);
+    pivot_track_pose(start, scene->track_pivots[static_cast<size_t>(hand.hand) & 1u]);
+    scene->world.add(e, start);
     scene->tools.push_back(e);
   }
 

@@ -8,6 +8,7 @@
 //   capsulorhexis:    cornea, capsule, iris, lens_surface
 //   phaco_sculpting:  cornea, capsule, iris, lens (tetrahedra)
 //   nucleus_removal:  cornea, capsule, iris, lens (simplex cells, grooved; lens_fragments.hpp)
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -28,6 +29,7 @@
 #include "procedures/eye/resolution.hpp"
 #include "procedures/scene/carried_state.hpp"
 #include "procedures/scene/haptic_port.hpp"
+#include "procedures/scene/track_pivot.hpp"
 
 namespace phaco {
 
@@ -68,6 +70,9 @@ struct Scene {
   double mesh_load_s = 0;         // wall time to load or build the meshes
   HapticPort* haptics = nullptr;  // from SceneOptions
   CarriedState carried;           // from SceneOptions (empty: the drill's start state)
+  // Per hand (indexed as Hand): its track moved from the drill's default main port into the
+  // carried one (procedures/scene/track_pivot); none on a fresh eye.
+  std::array<std::optional<TrackPivot>, 2> track_pivots;
 
   std::optional<Entity> body(BodyPart part) const;
 };

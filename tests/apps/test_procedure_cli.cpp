@@ -1,6 +1,7 @@
 // `phaco run/validate/report/compare` on a procedure (issue 20 item 1, docs/procedures.md), as a
 // user meets them: the summary's step scores and total, the JSON report, the HTML page with a
-// page per step, a step-by-step comparison, and bad files named. Two short steps at level 0.
+// page per step, a step-by-step comparison, each step stored as a record, and bad files named.
+// Two short steps at level 0.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -72,9 +73,45 @@ TEST(ProcedureCli, BadProceduresAreNamed) {
   EXPECT_NE(r.output.find("steps[1].scenario: the steps go in the operation's order"),
             std::string::npos)
       << r.output;
-  r = phaco("run " + short_procedure(dir).string() + " --trainee someone");
+  r = phaco("run " + short_procedure(dir).string() + " --haptics scripted");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.output.find("--trainee is for a drill scenario"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--haptics is for a drill scenario"), std::string::npos) << r.output;
+  r = phaco("run " + short_procedure(dir).string() + " --record " + (dir / "r.sqlite").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--record needs --trainee"), std::string::npos) << r.output;
+}
+
+// --record/--trainee store each step as its drill's record, marked with the procedure; the
+// incision step (a fresh eye) replays from its export to the same state hash.
+TEST(ProcedureCli, EachStepIsStoredAsItsDrillsRecord) {
+  const fs::path dir = temp_dir("procedure-record");
+  const fs::path db = dir / "records.sqlite";
+  auto r = phaco("run " + short_procedure(dir).string() + " --record " + db.string() +
+                 " --trainee ana --report " + (dir / "run.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("step 2 capsulorhexis recorded as record"), std::string::npos)
+      << r.output;
+  const nlohmann::json run = nlohmann::json::parse(read_text(dir / "run.json"));
+  r = phaco("history ana --json --db " + db.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json h = nlohmann::json::parse(r.output);
+  ASSERT_EQ(h["records"].size(), 2u);
+  EXPECT_EQ(h["records"][0]["drill"], "corneal_incision");
+  EXPECT_EQ(h["records"][1]["drill"], "capsulorhexis");
+  EXPECT_EQ(h["records"][1]["id"], run["steps"][1]["record_id"]);
+
+  const std::string id = std::to_string(h["records"][0]["id"].get<int64_t>());
+  r = phaco("export " + id + " --db " + db.string() + " --json " + (dir / "e.json").string() +
+            " --scenario " + (dir / "step1.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json e = nlohmann::json::parse(read_text(dir / "e.json"));
+  EXPECT_EQ(e["report"]["procedure"]["step"], 1);
+  EXPECT_EQ(e["report"]["procedure"]["steps"], 2);
+  EXPECT_DOUBLE_EQ(e["report"]["procedure"]["total"].get<double>(), run["total"].get<double>());
+  r = phaco("run " + (dir / "step1.json").string() + " --report " + (dir / "again.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(read_text(dir / "again.json"))["state_hash"],
+            run["steps"][0]["state_hash"]);
 }
 
 }  // namespace

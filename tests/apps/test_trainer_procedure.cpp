@@ -1,8 +1,10 @@
 // phaco-trainer --procedure under Xvfb (issue 20 item 1, docs/procedures.md): the steps follow one
 // another in the trainer, each step's score is printed, the scripted run closes when done, and
-// --procedure-out's recording replays with `phaco run` to the same scores and state hashes.
+// --procedure-out's recording replays with `phaco run` to the same scores and state hashes, and
+// --stats covers every step.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -34,7 +36,8 @@ TEST(TrainerProcedure, StepsThroughAndItsRecordingReplays) {
   const auto r =
       shell(leaks + "xvfb-run -a -s '-screen 0 1280x720x24' " + std::string(PHACO_TRAINER_BIN) +
             " --procedure " + (dir / "p.json").string() + " --procedure-out " +
-            (dir / "rec").string() + " --left track --right track --size 960x600");
+            (dir / "rec").string() + " --left track --right track --size 960x600 --stats " +
+            (dir / "stats.json").string() + " --stats-after 3600");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("procedure: step 1 corneal_incision scored"), std::string::npos)
       << r.output;
@@ -54,6 +57,18 @@ TEST(TrainerProcedure, StepsThroughAndItsRecordingReplays) {
   }
   EXPECT_TRUE(again["steps"][1]["carried_in"].contains("main_port"));
   EXPECT_EQ(live["total"], again["total"]);
+
+  // --stats over a procedure (phaco-perf trainer): written at its end, over every step.
+  const nlohmann::json stats = nlohmann::json::parse(read_text(dir / "stats.json"));
+  ASSERT_EQ(stats["steps"].size(), 2u) << stats.dump();
+  uint64_t frames = 0;
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(stats["steps"][i]["drill"], live["steps"][i]["drill"]) << i;
+    EXPECT_EQ(stats["steps"][i]["sim_frames"], live["steps"][i]["frames"]) << i;
+    frames += stats["steps"][i]["sim_frames"].get<uint64_t>();
+  }
+  EXPECT_EQ(stats["sim_frames"], frames);
+  EXPECT_GT(stats["frames"].get<uint64_t>(), 0u) << "render frames";
 }
 
 }  // namespace
