@@ -269,8 +269,6 @@ void finish_segment(CutMesh& m, CutPath& path, const CutSettings& s, SegmentRepo
     path.hint_triangle = m.topology.vertex_triangle[path.tip];
 }
 
-}  // namespace
-
 // Behind the tip and within slit_mm of the slit's last stretch, taken as straight: the segment from
 // the tip back along the last direction, ten slit widths long (lip vertices are too sparse to
 // measure from: the remesh merges them along straight cuts).
@@ -287,6 +285,8 @@ bool in_own_slit(const CutMesh& m, const CutPath& path, const Vec3& goal, const 
   const Vec3 nearest = -std::min(behind, length) * path.direction;
   return (from_tip - nearest).norm() < s.slit_mm;
 }
+
+}  // namespace
 
 SegmentReport cut_towards(CutMesh& m, CutPath& path, const Vec3& tool_point, const CutSettings& s,
                           EditLog& log) {
