@@ -11,6 +11,7 @@
 //   phaco-perf drills       issue 7: expert and novice drills, difficulty levels, comparisons
 //   phaco-perf tear         issue 17: forceps force on the capsulorhexis flap against time, bands
 //   phaco-perf trainer      issue 8: phaco-trainer's frame rate on the software renderer
+//   phaco-perf trainer-ab   issue 24: this build's trainer against an earlier one, interleaved
 //   phaco-perf sweep        issue 9: every drill at every level, thread count and method
 //   phaco-perf soak         issue 18: the trainer drill after drill; memory, GL objects, haptics
 //   phaco-perf nucleus      issue 19: the nucleus_removal expert per level, 1 and 2 threads
@@ -91,6 +92,14 @@ studies:
       scripted hands: render frame rate and frame times, simulation rate and haptic period, with
       and without rendering; then issue 20's scripted expert procedure (phaco-trainer --procedure)
       from start to end, with and without rendering. About 8 minutes (quick 2). Needs xvfb-run.
+  trainer-ab --against OLD_TRAINER [--against-data DIR] [--label TEXT] [--variant NAME[@DRILL]=DIR]...
+             [--reps N] [--seconds S] [--drill NAME]...
+      Issue 24, this build's phaco-trainer against an earlier build's (a binary built from an
+      older commit, reading that commit's data/ with --against-data), run as `trainer` runs each
+      drill, the builds alternating run by run (ABBA) N times (default 4, S = 20 s each); each
+      repetition gives a paired fps ratio, reported with its 95 % interval. A variant is this
+      build reading another data folder (e.g. a drill with a body taken out; @DRILL: in that
+      drill only), to tell a scene's content from the code. About 1 minute per run (default: 3 drills x 2 builds x 4 = 24 runs).
   sweep [--max-level L] [--drill NAME]... [--replot]
   sweep --reference [--drill NAME]... [--reference-level L] [--reference-dt-divisor K]
       Issues 9 and 17, the whole trainer under load: each drill's scripted expert run to its end
@@ -195,6 +204,8 @@ int main(int argc, char** argv) {
       perf::run_tear(options);
     } else if (cmd == "trainer") {
       perf::run_trainer_study(options);
+    } else if (cmd == "trainer-ab") {
+      perf::run_trainer_ab(options);
     } else if (cmd == "sweep") {
       perf::run_sweep(options);
     } else if (cmd == "soak") {

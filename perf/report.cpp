@@ -75,8 +75,9 @@ void write_json(const Table& t, const fs::path& file) {
 const std::vector<std::string>& study_order() {
   // The sweep first: it holds the issue-9 targets and the reading of the whole trainer.
   static const std::vector<std::string> order = {
-      "sweep",  "foundation", "bandwidth", "membrane", "cut",     "lens",    "haptics",
-      "drills", "tear_force", "trainer",   "soak",     "nucleus", "records", "cohorts"};
+      "sweep",      "foundation", "bandwidth", "membrane",   "cut",
+      "lens",       "haptics",    "drills",    "tear_force", "trainer",
+      "trainer_ab", "soak",       "nucleus",   "records",    "cohorts"};
   return order;
 }
 

@@ -24,6 +24,7 @@ void run_haptics(const StudyOptions& options);
 void run_drills(const StudyOptions& options);
 void run_tear(const StudyOptions& options);
 void run_trainer_study(const StudyOptions& options);
+void run_trainer_ab(const StudyOptions& options);
 void run_sweep(const StudyOptions& options);
 void run_soak(const StudyOptions& options);
 void run_records(const StudyOptions& options);

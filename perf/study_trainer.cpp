@@ -5,12 +5,9 @@
 // rendering does not slow the simulation or the haptic thread (DESIGN.md §5). The trainer runs as
 // its own process, exactly as a trainee starts it; it writes its figures with --stats. Then the
 // scripted expert's whole procedure (issue 20, phaco-trainer --procedure), render on and off.
-#include <unistd.h>
 
 #include <array>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -20,6 +17,7 @@
 #include "perf/plot.hpp"
 #include "perf/report.hpp"
 #include "perf/studies.hpp"
+#include "perf/trainer_run.hpp"
 #include "procedures/eye/eye_params.hpp"
 
 namespace phaco::perf {
@@ -27,36 +25,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kWidth = 1280, kHeight = 720;
 constexpr double kTargetFps = 30.0;
-
-// phaco-trainer beside this executable's build: <build>/perf/phaco-perf → <build>/apps/.
-fs::path trainer_binary() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  const fs::path bin = self.parent_path().parent_path() / "apps" / "phaco-trainer";
-  if (ec || !fs::exists(bin)) {
-    throw InputError("trainer: phaco-trainer not found at " + bin.string() +
-                     " (build the target phaco-trainer)");
-  }
-  return bin;
-}
 
 std::string met(bool ok) {
   return ok ? "met" : "**missed**";
-}
-
-struct TrainerRun {
-  std::string drill;  // or "procedure"
-  bool render = true;
-  nlohmann::json stats;
-  double load_before = -1, load_after = -1;  // 1-min load average: the machine may be shared
-};
-
-double load_1min() {
-  std::ifstream in("/proc/loadavg");
-  double one = -1;
-  return in >> one ? one : -1.0;
 }
 
 // "name on/off before → after, ..." for the runs.
@@ -67,36 +39,6 @@ std::string loads(const std::vector<const TrainerRun*>& runs) {
            fmt("%.1f", r->load_before) + " → " + fmt("%.1f", r->load_after);
   }
   return out;
-}
-
-// `what`: "--drill NAME" or "--procedure FILE"; `tail`: how long (and any other options).
-TrainerRun run_trainer(const fs::path& bin, const fs::path& dir, const std::string& name,
-                       const std::string& what, const std::string& tail, bool render) {
-  const fs::path out = dir / ("trainer_" + name + (render ? "" : "_norender") + ".stats.json");
-  fs::remove(out);
-  const std::string cmd = "xvfb-run -a -s '-screen 0 " + std::to_string(kWidth) + "x" +
-                          std::to_string(kHeight) + "x24' " + bin.string() + " " + what +
-                          " --left scripted --right scripted --size " + std::to_string(kWidth) +
-                          "x" + std::to_string(kHeight) + " --stats " + out.string() + " " + tail +
-                          (render ? "" : " --no-render") + " > /dev/null 2>&1";
-  const double before = load_1min();
-  const int rc = std::system(cmd.c_str());
-  const double after = load_1min();
-  if (rc != 0 || !fs::exists(out)) {
-    throw InputError("trainer: `" + cmd + "` failed (exit " + std::to_string(rc) +
-                     "); is xvfb-run installed (scripts/install-deps.sh)?");
-  }
-  std::ifstream in(out);
-  return {name, render, nlohmann::json::parse(in), before, after};
-}
-
-TrainerRun run_drill(const fs::path& bin, const fs::path& dir, const std::string& drill,
-                     bool render, double seconds) {
-  // The drill runs longer than the measurement: the scripted hands hold their last pose.
-  return run_trainer(
-      bin, dir, drill, "--drill " + drill,
-      "--duration " + std::to_string(seconds + 30) + " --stats-after " + std::to_string(seconds),
-      render);
 }
 
 // The scripted expert's procedure (issue 20): every step, each on the eye the steps before it
@@ -186,7 +128,7 @@ void run_trainer_study(const StudyOptions& options) {
   for (const auto& d : drills) {
     for (bool render : {true, false}) {
       progress.step("trainer: " + d + (render ? "" : " (no render)"));
-      runs.push_back(run_drill(bin, dir, d, render, seconds));
+      runs.push_back(run_trainer_drill(bin, dir, d, render, seconds));
     }
   }
   const fs::path procedure = eye::data_dir() / "procedures" / "cataract_expert.json";
@@ -213,8 +155,9 @@ void run_trainer_study(const StudyOptions& options) {
                "wall_s"};
   std::string md = "## The trainer: frame rate on the software renderer (issue 8)\n\n";
   md += std::string("Measured by `phaco-perf trainer") + (options.quick ? " --quick" : "") + "`, " +
-        load + ". `phaco-trainer` under Xvfb at " + std::to_string(kWidth) + "×" +
-        std::to_string(kHeight) + ", the default eye (level 3), both hands on scripted devices " +
+        load + ". `phaco-trainer` under Xvfb at " + std::to_string(kTrainerWidth) + "×" +
+        std::to_string(kTrainerHeight) +
+        ", the default eye (level 3), both hands on scripted devices " +
         "through the 1 kHz loop, " + fmt("%.0f", seconds) +
         " s per run; *render off* is the same process and loop drawing nothing. The simulation's "
         "target rate is 1/dt = 120 Hz, the haptic period 1000 us; the render target is 30 fps.\n\n";
