@@ -8,6 +8,7 @@
 #include "engine/schedule/parallel.hpp"
 #include "systems/sph/kernel.hpp"
 #include "systems/sph/neighbours.hpp"
+#include "systems/sph/simd8.hpp"
 
 namespace phaco::sph {
 
@@ -59,6 +60,59 @@ void mark_mixed_cells(const Grid& g, std::span<const uint32_t> fragment, Contact
   });
 }
 
+// The contact sums of slots [from, to) (one grid cell's; sorted orders). Eight candidates at a
+// time are tested for r² < h² and another fragment (labels in slot order: no gather), which
+// rejects the many neighbours of a particle's own fragment without a branch each; the few pairs
+// left are summed one by one in candidate order, exactly as a scalar walk over the same runs
+// would, so the forces have the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+uint64_t
+contact_slots(const Grid& g, const ContactParticles& in, const uint32_t* fragment_slot,
+              const ContactParams& params, Candidates& candidates, uint32_t from, uint32_t to,
+              float* fx, float* fy, float* fz) {
+  using simd8::F8;
+  using simd8::I8;
+  using simd8::load8;
+  const F8 h2 = simd8::splat(g.h2);
+  const float* X = g.x.data();
+  const float* Y = g.y.data();
+  const float* Z = g.z.data();
+  uint64_t pairs = 0;
+  for (uint32_t i = from; i < to; ++i) {
+    const uint32_t pi = g.id[i];
+    const float xs = g.x[i], ys = g.y[i], zs = g.z[i];
+    const F8 xi = simd8::splat(xs), yi = simd8::splat(ys), zi = simd8::splat(zs);
+    const I8 fi = simd8::splat(static_cast<int32_t>(fragment_slot[i]));
+    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+    for (const Run run : candidates.runs(i)) {
+      for (uint32_t j = run.begin; j < run.end; j += 8) {
+        const F8 dx = xi - load8(X + j), dy = yi - load8(Y + j), dz = zi - load8(Z + j);
+        const F8 r2 = dx * dx + dy * dy + dz * dz;
+        const I8 hit = (r2 < h2) & (load8(fragment_slot + j) != fi) & simd8::below(j, run.end);
+        if (!simd8::any(hit)) continue;
+        for (int l = 0; l < 8; ++l) {
+          if (!hit[l]) continue;
+          const uint32_t pj = g.id[j + l];
+          const float vd = (in.vx[pi] - in.vx[pj]) * dx[l] + (in.vy[pi] - in.vy[pj]) * dy[l] +
+                           (in.vz[pi] - in.vz[pj]) * dz[l];
+          const float s = pair_force_scale(params, r2[l], vd);
+          sx += s * dx[l];
+          sy += s * dy[l];
+          sz += s * dz[l];
+          ++pairs;
+        }
+      }
+    }
+    fx[pi] += sx;
+    fy[pi] += sy;
+    fz[pi] += sz;
+  }
+  return pairs;
+}
+
 }  // namespace
 
 float pair_force_scale(const ContactParams& p, float r2, float vdotd) {
@@ -92,17 +146,42 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
   if (stats.particles < 2) return stats;
   Grid& g = scratch.grid;
   build_grid(g, in.x, in.y, in.z, {}, params.h, params.order, scratch.members);
-  const bool sorted = params.order != CellOrder::UnsortedHash;
-  if (sorted) mark_mixed_cells(g, in.fragment, scratch);
 
-  const uint64_t twice = parallel_reduce_ordered(
-      0u, g.count, kGrain, uint64_t{0},
-      [&](uint32_t b, uint32_t e) {
-        uint64_t pairs = 0;
-        float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-        auto pass = [&](uint32_t from, uint32_t to) {
+  const bool sorted = params.order != CellOrder::UnsortedHash;
+  uint64_t twice = 0;
+  if (sorted) {
+    mark_mixed_cells(g, in.fragment, scratch);
+    // Fragment labels in slot order, padded like the positions (the last block reads past the
+    // end; those lanes are masked).
+    scratch.fragment_slot.resize(size_t{g.count} + kPad);
+    for (uint32_t s = 0; s < g.count; ++s) scratch.fragment_slot[s] = in.fragment[g.id[s]];
+    std::fill(scratch.fragment_slot.begin() + g.count, scratch.fragment_slot.end(), 0u);
+    twice = parallel_reduce_ordered(
+        0u, g.count, kGrain, uint64_t{0},
+        [&](uint32_t b, uint32_t e) {
+          uint64_t pairs = 0;
+          Candidates candidates(g);
+          // Slots of one cell at a time; a cell whose neighbourhood holds one fragment only has
+          // no pair to sum (its slots would add +0 to their forces): skipped.
+          for (uint32_t s = b; s < e;) {
+            const uint32_t cell = g.slot_cell[s];
+            const uint32_t to = std::min(e, g.cell_begin[cell + 1]);
+            if (scratch.mixed[cell])
+              pairs += contact_slots(g, in, scratch.fragment_slot.data(), params, candidates, s, to,
+                                     fx.data(), fy.data(), fz.data());
+            s = to;
+          }
+          return pairs;
+        },
+        [](uint64_t a, uint64_t b) { return a + b; });
+  } else {
+    twice = parallel_reduce_ordered(
+        0u, g.count, kGrain, uint64_t{0},
+        [&](uint32_t b, uint32_t e) {
+          uint64_t pairs = 0;
+          float sx = 0.0f, sy = 0.0f, sz = 0.0f;
           for_each_neighbour(
-              g, from, to,
+              g, b, e,
               [&](uint32_t i, uint32_t j, float dx, float dy, float dz, float r2) {
                 const uint32_t pi = g.id[i], pj = g.id[j];
                 if (in.fragment[pj] == in.fragment[pi]) return;
@@ -121,22 +200,10 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
                 fz[pi] += sz;
                 sx = sy = sz = 0.0f;
               });
-        };
-        if (!sorted) {
-          pass(b, e);
           return pairs;
-        }
-        // Slots of one cell at a time; a cell whose neighbourhood holds one fragment only has no
-        // pair to sum (its slots would add +0 to their forces): skipped.
-        for (uint32_t s = b; s < e;) {
-          const uint32_t cell = g.slot_cell[s];
-          const uint32_t to = std::min(e, g.cell_begin[cell + 1]);
-          if (scratch.mixed[cell]) pass(s, to);
-          s = to;
-        }
-        return pairs;
-      },
-      [](uint64_t a, uint64_t b) { return a + b; });
+        },
+        [](uint64_t a, uint64_t b) { return a + b; });
+  }
   stats.pairs = twice / 2;
   return stats;
 }

@@ -53,6 +53,7 @@ struct ContactScratch {
   std::vector<uint32_t> members;           // boundary particles
   std::vector<uint32_t> cell_lo, cell_hi;  // per grid cell: smallest and largest fragment in it
   std::vector<uint8_t> mixed;              // per grid cell: another fragment in its 3×3×3 block
+  std::vector<uint32_t> fragment_slot;     // per slot (+ kPad): the fragment label
 };
 
 struct ContactStats {

@@ -7,33 +7,18 @@
 #include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "systems/sph/kernel.hpp"
-
-// GCC notes that 32-byte vector arguments change the ABI without AVX; these helpers are internal
-// and inlined, so no ABI boundary is crossed.
-#pragma GCC diagnostic ignored "-Wpsabi"
+#include "systems/sph/simd8.hpp"
 
 namespace phaco::sph {
 
 namespace {
 
+using simd8::F8;
+using simd8::I8;
+using simd8::load8;
+using simd8::splat;
+
 constexpr uint32_t kGrain = 1024;
-
-// Eight floats / eight ints as GCC/Clang vector extensions: SIMD on any target without
-// intrinsics (two SSE registers on baseline x86-64, one AVX register in the avx2 clone below).
-// The arithmetic per lane is the same in every clone (no FMA is enabled), so results do not
-// depend on which clone runs.
-typedef float F8 __attribute__((vector_size(32)));
-typedef int32_t I8 __attribute__((vector_size(32)));
-
-inline F8 load8(const float* p) {
-  F8 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-inline F8 splat(float v) {
-  return F8{v, v, v, v, v, v, v, v};
-}
 
 // Σ m_j (h² − r²)³ over the candidates [b, e) inside h, eight at a time into lane sums and counts
 // (candidate b + 8k + l goes to lane l, so a particle's sum does not depend on the chunking). The
@@ -56,8 +41,7 @@ inline void accumulate_run(const Grid& g, uint32_t b, uint32_t e, F8 xi, F8 yi, 
     cnt -= in;
   }
   if (j < e) {
-    const I8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
-    const I8 valid = (static_cast<int32_t>(j) + lane) < static_cast<int32_t>(e);
+    const I8 valid = simd8::below(j, e);
     const F8 dx = xi - load8(X + j), dy = yi - load8(Y + j), dz = zi - load8(Z + j);
     const F8 d = h2 - (dx * dx + dy * dy + dz * dz);
     const I8 in = (d > zero) & valid;

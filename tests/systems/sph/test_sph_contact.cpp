@@ -290,6 +290,51 @@ TEST(SphContact, OnePairStopsWhereStiffnessToStopSays) {
   }
 }
 
+// Every order's pass (the sorted ones filter eight candidates at a time) against the O(n²) sum
+// over all pairs: the same pairs, and each particle's force within float rounding of the
+// double-precision sum of the same pair forces. Three fragments, a size that is not a multiple of
+// eight, a few coincident pairs (no direction: no force) and non-boundary particles (no part).
+TEST(SphContact, EveryOrderFindsThePairsABruteForceSumFinds) {
+  Bodies b = interleaved(2999, 31);
+  for (uint32_t i = 0; i < b.size(); i += 7) b.fragment[i] = 2;
+  for (uint32_t i = 0; i + 1 < 40; i += 2)  // coincident pairs of two fragments
+    b.add(b.x[i], b.y[i], b.z[i], 0, 0, 0, b.fragment[i] == 0 ? 1u : 0u);
+  ContactParams p;
+  p.h = 0.05f, p.stiffness = 2.0f, p.damping = 1e-4f;
+  const uint32_t n = b.size();
+  std::vector<double> rx(n, 0.0), ry(n, 0.0), rz(n, 0.0);
+  uint64_t pairs = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    for (uint32_t j = 0; j < n; ++j) {
+      if (j == i || !b.boundary[i] || !b.boundary[j] || b.fragment[i] == b.fragment[j]) continue;
+      const float dx = b.x[i] - b.x[j], dy = b.y[i] - b.y[j], dz = b.z[i] - b.z[j];
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      if (!(r2 < p.h * p.h)) continue;
+      const float vd =
+          (b.vx[i] - b.vx[j]) * dx + (b.vy[i] - b.vy[j]) * dy + (b.vz[i] - b.vz[j]) * dz;
+      const float s = pair_force_scale(p, r2, vd);
+      rx[i] += s * dx, ry[i] += s * dy, rz[i] += s * dz;
+      pairs += i < j;
+    }
+  }
+  double peak = 0;
+  for (uint32_t i = 0; i < n; ++i)
+    peak = std::max({peak, std::abs(rx[i]), std::abs(ry[i]), std::abs(rz[i])});
+  ASSERT_GT(pairs, 500u);
+  for (CellOrder order : kOrders) {
+    p.order = order;
+    Forces f(n);
+    ContactScratch scratch;
+    const ContactStats st = fragment_contact(b.view(), 3, p, scratch, f.x, f.y, f.z);
+    EXPECT_EQ(st.pairs, pairs) << to_string(order);
+    double worst = 0;
+    for (uint32_t i = 0; i < n; ++i)
+      worst = std::max(
+          {worst, std::abs(f.x[i] - rx[i]), std::abs(f.y[i] - ry[i]), std::abs(f.z[i] - rz[i])});
+    EXPECT_LT(worst, 1e-5 * peak) << to_string(order);
+  }
+}
+
 TEST(SphContact, ForcesAreBitIdenticalForOneAndTwoThreads) {
   const Bodies b = interleaved(30000, 12);
   ContactParams p;
