@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "components/particles.hpp"
 #include "components/tool.hpp"
@@ -216,6 +217,7 @@ RimTears make_rim_tears(const Scene& scene, double tear_resistance_mn) {
     }
     rt.tool_radius_mm.push_back(r);
   }
+  rt.tool_max_force_mn.assign(scene.tools.size(), 0.0);
   return rt;
 }
 
@@ -243,7 +245,7 @@ bool press_rim(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, double time_s)
       const double depth = push_on(t, pose.pos, shaft, r, s, 4.0 * r);
       if (depth > 0) {
         t.pushed_mm = std::max(t.pushed_mm, depth);
-        rt.max_force_mn = std::max(rt.max_force_mn, s.stiffness_mn_mm * depth);
+        rt.tool_max_force_mn[k] = std::max(rt.tool_max_force_mn[k], s.stiffness_mn_mm * depth);
         pressed = true;
         if (!t.state.complete &&
             s.stiffness_mn_mm * (t.pushed_mm - t.advance_mm) >= s.notched_strength_mn)
@@ -258,7 +260,7 @@ bool press_rim(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, double time_s)
     rt.min_clearance_mm = std::min(rt.min_clearance_mm, -p.depth_mm);
     if (p.depth_mm <= 0) continue;
     const double force = s.stiffness_mn_mm * p.depth_mm;
-    rt.max_force_mn = std::max(rt.max_force_mn, force);
+    rt.tool_max_force_mn[k] = std::max(rt.tool_max_force_mn[k], force);
     pressed = true;
     const uint32_t notch = notch_near(m, rt.rim, p.at, 2.0 * r, s.notch_angle_deg);
     const bool notched = notch != kInvalidIndex;
@@ -276,6 +278,7 @@ bool press_rim(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, double time_s)
     rt.events.push_back({time_s, "rim_tear", k, "force_mN", force});
     rt.pending.push_back(static_cast<uint32_t>(rt.tears.size() - 1));
   }
+  for (const double f : rt.tool_max_force_mn) rt.max_force_mn = std::max(rt.max_force_mn, f);
   rt.pressing_frames += pressed;
   return !rt.pending.empty();
 }
@@ -325,6 +328,11 @@ void rim_metrics(Scene& scene, nlohmann::json& metrics) {
   std::sort(notches.begin(), notches.end());
   metrics["rim.notches"] = std::unique(notches.begin(), notches.end()) - notches.begin();
   metrics["rim.max_force_mN"] = rt.max_force_mn;
+  for (size_t k = 0; k < scene.tools.size() && k < rt.tool_max_force_mn.size(); ++k) {
+    if (rt.tool_radius_mm[k] <= 0) continue;
+    const Hand hand = scene.world.at<Tool>(scene.tools[k]).hand;
+    metrics["rim.max_force_mN." + std::string(to_string(hand))] = rt.tool_max_force_mn[k];
+  }
   if (rt.min_clearance_mm < 1e9) metrics["rim.clearance_mm.min"] = rt.min_clearance_mm;
   metrics["rim.pressing_frames"] = rt.pressing_frames;
   metrics["rim.tears"] = rt.tears.size();

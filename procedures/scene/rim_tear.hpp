@@ -117,8 +117,9 @@ struct RimTears {
   std::vector<uint32_t> pending;  // tears to run in this frame's edit (indices)
   // Over the run.
   double max_force_mn = 0.0;
-  double min_clearance_mm = 1e9;  // the closest a crossing tool's section came to the rim
-  uint64_t pressing_frames = 0;   // frames in which a tool pressed the rim (δ > 0)
+  std::vector<double> tool_max_force_mn;  // per scene tool
+  double min_clearance_mm = 1e9;          // the closest a crossing tool's section came to the rim
+  uint64_t pressing_frames = 0;           // frames in which a tool pressed the rim (δ > 0)
   uint32_t to_equator = 0;
 };
 
@@ -147,9 +148,9 @@ bool press_rim(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, double time_s)
 // Runs the pending tears (in the capsule's rest shape, inside capsule_cut's edit).
 void run_rim_tears(cut::CutMesh& m, CapsuleCutting& cc, double time_s);
 
-// rim.notches, rim.max_force_mN, rim.clearance_mm.min, rim.pressing_frames, rim.tears,
-// rim.tears_to_equator, rim.tear_length_mm.max, for a scene whose capsule has a rim (an opening)
-// and a tool that can press it; nothing otherwise.
+// rim.notches, rim.max_force_mN (and .left / .right per hand), rim.clearance_mm.min,
+// rim.pressing_frames, rim.tears, rim.tears_to_equator, rim.tear_length_mm.max, for a scene whose
+// capsule has a rim (an opening) and a tool that can press it; nothing otherwise.
 void rim_metrics(Scene& scene, nlohmann::json& metrics);
 
 }  // namespace phaco
