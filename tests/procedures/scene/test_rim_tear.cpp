@@ -201,6 +201,19 @@ TEST(RimTear, ANickedRimTearsAtTheTearResistance) {
   EXPECT_TRUE(drill_report(*scene).complications.empty());
 }
 
+// A drill alone starts with a whole capsule: no opening, no rim, nothing torn or reported, however
+// far the probe goes.
+TEST(RimTear, ADrillAloneHasNoRimToTear) {
+  Opened whole;
+  whole.rim_mm = 2.6;
+  auto scene = run_on(pushed_probe(whole, 2.5), CarriedState{});
+  EXPECT_TRUE(rim_of(*scene).rim.empty());
+  EXPECT_TRUE(rim_of(*scene).tears.empty());
+  const DrillReport r = drill_report(*scene);
+  EXPECT_FALSE(r.metrics.contains("rim.max_force_mN"));
+  EXPECT_TRUE(r.complications.empty());
+}
+
 TEST(RimTear, ATearToTheEquatorFailsTheProcedureAndSaysWhy) {
   const Opened o = opened_capsule(false);
   Procedure p;
