@@ -62,6 +62,7 @@ const std::vector<EyeParamRange>& eye_param_ranges() {
       {"capsule.radius_mm", 2, 6},
       {"capsule.perforation_force_mn", 1, 1000},
       {"capsule.rim_strength_mn", 1, 10000},
+      {"capsule.rim_stiffness_mn_mm", 1, 10000},
       {"capsule.tear_energy_j_m2", 10, 100000},
       {"capsule_model.prestretch", 1e-4, 0.5},
       {"capsule_model.damping_per_s", 0.01, 1000},

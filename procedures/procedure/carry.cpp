@@ -68,7 +68,8 @@ void carry_capsule(Scene& scene, CarriedState& state) {
   const auto capsule = scene.body(BodyPart::Capsule);
   if (!capsule) return;
   CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
-  if (!cc || cc->cut_segments == 0) return;  // nothing cut: the capsule is as it came
+  // Nothing cut or torn: the capsule is as it came.
+  if (!cc || (cc->cut_segments == 0 && cc->rim.tears.empty())) return;
   const Particles& p = scene.world.at<Particles>(*capsule);
   const Triangles& t = scene.world.at<Triangles>(*capsule);
   const cut::CutMesh m{const_cast<Particles&>(p), const_cast<Triangles&>(t),

@@ -279,7 +279,8 @@ bool flap_pull(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, Vec3& pull, do
 // swaps), the edits, the swap back, then each new particle placed on the deformed capsule by its
 // origin.
 void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const Vec3& cut_at,
-                        bool pulling, const Vec3& pull, double elongation) {
+                        bool pulling, const Vec3& pull, double elongation, bool rim_tearing,
+                        double time_s) {
   Particles& p = m.particles;
   const size_t replay_from = cc.log.origins.size();
   std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
@@ -295,6 +296,7 @@ void edit_in_rest_shape(cut::CutMesh& m, CapsuleCutting& cc, bool cutting, const
     cc.tear_steps_last_frame = run.steps;
     cc.max_tear_steps_per_frame = std::max<uint64_t>(cc.max_tear_steps_per_frame, run.steps);
   }
+  if (rim_tearing) run_rim_tears(m, cc, time_s);
   std::swap(p.x, cc.rest_x), std::swap(p.y, cc.rest_y), std::swap(p.z, cc.rest_z);
   const uint32_t n = p.slots.size();
   p.x.resize(n), p.y.resize(n), p.z.resize(n);
@@ -332,6 +334,7 @@ bool add_capsule_cutting(Scene& scene) {
       rule == "flap_force" ? tear::TearRule::FlapForce : tear::TearRule::MostStressedSpring;
   cc.tear.threshold_mn = tear::tear_resistance_mn(scene.params.get("capsule.tear_energy_j_m2"),
                                                   scene.params.get("capsule.thickness_mm"));
+  cc.rim = make_rim_tears(scene, cc.tear.threshold_mn);
   double edge = 0.0;
   uint32_t counted = 0;
   for (uint32_t t = 0; t < tr.slots.size(); ++t) {
@@ -382,8 +385,11 @@ SystemDesc capsule_cut_system(Scene& scene) {
         cc.tearing = false, cc.flap_force_mn = 0.0, cc.tear_steps_last_frame = 0;
         const bool cutting = cystotome_contact(scene, m, cc, cut_at);
         const bool pulling = !cutting && flap_pull(scene, m, cc, pull, elongation);
-        if (cutting || pulling)
-          edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull, elongation);
+        // A probe or chopper pressing the rhexis rim (rim_tear.hpp), measured where it lies.
+        const bool rim_tearing = press_rim(scene, m, cc, ctx.time_s + ctx.dt_s);
+        if (cutting || pulling || rim_tearing)
+          edit_in_rest_shape(m, cc, cutting, cut_at, pulling, pull, elongation, rim_tearing,
+                             ctx.time_s + ctx.dt_s);
         const double edit_ms = elapsed_ms(t0);
         cc.edit_ms_total += edit_ms;
         cc.edit_ms_max = std::max(cc.edit_ms_max, edit_ms);

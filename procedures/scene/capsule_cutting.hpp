@@ -39,6 +39,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/schedule/system.hpp"
+#include "procedures/scene/rim_tear.hpp"
 #include "systems/cut/grasp_point.hpp"
 #include "systems/cut/progressive_cut.hpp"
 #include "systems/tear/tear.hpp"
@@ -83,6 +84,8 @@ struct CapsuleCutting {
   uint64_t max_tear_steps_per_frame = 0;
   // Springs (edge key) the held flap folded this frame, with their own rest lengths.
   std::vector<std::pair<uint64_t, float>> folded;
+  // Tools pressing on the rhexis rim in the later steps (rim_tear.hpp): the tears they start.
+  RimTears rim;
   cut::EditLog log;  // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics patch after changes

@@ -154,6 +154,11 @@ void sample_tear(Scene& scene, DrillRecord& r, double t) {
   if (!capsule) return;
   const CapsuleCutting* cc = scene.world.get<CapsuleCutting>(*capsule);
   if (!cc) return;
+  // A tool pressing the rhexis rim started a tear, or one ran to the equator (rim_tear.hpp).
+  for (; r.rim_events_seen < cc->rim.events.size(); ++r.rim_events_seen) {
+    const RimTearEvent& e = cc->rim.events[r.rim_events_seen];
+    push_event(r, t, e.kind, static_cast<int>(e.tool), e.detail, e.value);
+  }
   if (!r.puncture && cc->cut_segments > 0) {
     for (const HandRecord& h : r.hands)
       if (h.kind == ToolKind::Cystotome) r.puncture = scene.world.at<ToolState>(h.tool).pos;

@@ -10,6 +10,7 @@
 #include "procedures/scene/drill_record.hpp"
 #include "procedures/scene/drill_score.hpp"
 #include "procedures/scene/nucleus_removal_metrics.hpp"
+#include "procedures/scene/rim_tear.hpp"
 #include "procedures/scene/scene.hpp"
 #include "procedures/scene/tool_ports.hpp"
 
@@ -56,6 +57,7 @@ DrillReport drill_report(Scene& scene) {
       break;
     }
   }
+  rim_metrics(scene, out.metrics);    // tools pressing the rhexis rim (an opening only)
   ports_metrics(scene, out.metrics);  // globe rotation, port force (ports on only)
   score(out, scene.drill);
   out.metrics["score"] = out.score;

@@ -65,6 +65,7 @@ struct DrillRecord {
   std::vector<double> t_s;
   std::vector<DrillEvent> events;
   size_t tear_events_seen = 0;
+  size_t rim_events_seen = 0;                   // CapsuleCutting::rim's events already pushed
   std::optional<Vec3> first_grasp;              // where forceps first closed (grasp.offset_mm)
   std::optional<Vec3> puncture;                 // the cystotome's tip when it first cut the capsule
   std::optional<NucleusRemovalRecord> nucleus;  // the nucleus_removal drill's measures

@@ -17,6 +17,13 @@ inline std::filesystem::path scene_cache_dir() {
              : std::filesystem::temp_directory_path() / "phaco-test-cache";
 }
 
+// Scene options with that cache, the rest default.
+inline SceneOptions scene_options() {
+  SceneOptions o;
+  o.cache_dir = scene_cache_dir();
+  return o;
+}
+
 inline Scenario repo_scenario(const char* name) {
   return load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) / "data/scenarios" / name);
 }

@@ -105,6 +105,16 @@ TEST(Procedure, TheExpertRunsEndToEndAndEachStepScoresAsItsDrillOnTheCarriedEye)
     EXPECT_LT(r.steps[i].run.metrics.value("ports.max_force_mN", 1e9), 10.0) << i;
     EXPECT_LT(r.steps[i].run.metrics.value("globe.max_rotation_deg", 1e9), 1.0) << i;
   }
+  // The later steps' tools work through the torn opening without tearing its rim (rim_tear.hpp):
+  // the sculpting probe's shaft passes under the subincisional rim, pressing it below a smooth
+  // rim's strength, and the expert's rim has no nick.
+  const double rim_strength = eye::default_eye_params().get("capsule.rim_strength_mn");
+  for (size_t i = 2; i < 4; ++i) {
+    const nlohmann::json& m = r.steps[i].run.metrics;
+    EXPECT_EQ(m.value("rim.tears", -1), 0) << i;
+    EXPECT_EQ(m.value("rim.notches", -1), 0) << i;
+    EXPECT_LT(m.value("rim.max_force_mN", 1e9), rim_strength) << i;
+  }
   double sum = 0;
   for (size_t i = 0; i < r.steps.size(); ++i) {
     const double score = r.steps[i].run.metrics.value("score", -1.0);
