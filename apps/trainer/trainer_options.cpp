@@ -71,7 +71,8 @@ panel or outside the window both tools stay put; hold the middle button or Shift
 pointer alone), wheel = depth (0.1 mm a click), left button = grip / ultrasound, right button =
 aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers = grip/pedal,
 bumpers = deeper); Space pauses; R restarts; G toggles the guidance cues; F1 shows the controls;
-F12 saves the view (--views); Esc quits. The label by each tip is its height above the tissue under it.
+F12 saves the view (--views); Esc quits. The label by each tip is its height above the tissue
+under it.
 An interactive run remembers the trainee, devices, drill and level it ended with in
 $XDG_CONFIG_HOME/openphaco/trainer.json (default ~/.config/openphaco) and starts with them when the
 command line does not say otherwise.

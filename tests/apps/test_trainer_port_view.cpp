@@ -53,7 +53,7 @@ xdotool key F1; wait_for '"controls_shown": false'
 sleep 1  # a frame with the pointer over the view and no overlay: the clutch engages
 n=0
 for at in "420 560" "390 240" "520 250"; do
-  xdotool mousemove $at; sleep 0.6
+  xdotool mousemove $at; sleep 1
   n=$((n + 1)); xdotool key F12; wait_for "\"views_saved\": $n"
 done
 xdotool key Escape
