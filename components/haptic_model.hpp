@@ -14,6 +14,8 @@
 //             nucleus (surface tets, or simplex cells) and loose fragments, for any tool; under
 //             ultrasound the material's reaction is capped (the tip cuts through it)
 //   held      a fragment held at the tip by aspiration (components/held_fragment.hpp)
+//   port      the corneal port the tool is in (issue 20 item 2): its tunnel, turned with the globe
+//             as the scene solved it, holds the shaft's line to its centre
 //
 // Fixed capacity so that a copy into the triple buffer never allocates (≈ 36 KiB per tool).
 // Plain data only; systems/haptic_model computes the force, procedures/scene fills it.
@@ -91,6 +93,18 @@ struct HapticTool {
   float cut_force_mn = 0;
 
   HeldFragment held;  // a fragment held at the tip, its load felt (held.held false: none)
+
+  // The port the tool is in (procedures/scene/tool_ports; systems/tool_eye's tunnel spring): the
+  // shaft's line is free across the slit's width and held by the tunnel's spring beyond it and
+  // through the slit. Where the scene's globe had it turned at publish; the device's own shaft is
+  // read each tick, so levering is felt at 1 kHz.
+  bool port_present = false;
+  std::array<float, 3> port_centre_mm{};  // middle of the tunnel, mm
+  std::array<float, 3> port_axis{};       // unit, along the tunnel into the eye
+  std::array<float, 3> port_width_dir{};  // unit, across the slit (along the limbus)
+  float port_half_width_mm = 0;           // free either side of the centre across the slit
+  float port_tunnel_length_mm = 0;        // outer to inner opening, mm
+  float port_stiffness_mn_per_mm = 0;     // tool_eye.tunnel_stiffness_mn_mm
 };
 
 struct HapticModel {

@@ -75,6 +75,9 @@ struct InputGlue {
   PointerClutch clutch;
   double wheel = 0;  // accumulated by the scroll callback
   bool tab_down = false, space_down = false, r_down = false, g_down = false, f1_down = false;
+  bool f12_down = false;
+  bool save_view = false;   // F12 was pressed: save the view this frame
+  int views_saved = 0;      // by F12 in this run (view-NNN numbers them)
   int64_t ui_state_ns = 0;  // when --ui-state was last written
 };
 
@@ -143,13 +146,14 @@ void load_font() {
     ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 14.0f, &config, kRanges);
 }
 
-void write_ui_state(const std::filesystem::path& file, const nlohmann::json& j) {
+void write_json_file(const std::filesystem::path& file, const nlohmann::json& j,
+                     const char* what = "the UI state") {
   // Whole or not at all: a reader never sees half a file.
   const std::filesystem::path tmp = file.string() + ".tmp";
   {
     std::ofstream out(tmp);
     out << j.dump(2) << "\n";
-    if (!out) throw InputError(tmp.string() + ": cannot write the UI state");
+    if (!out) throw InputError(tmp.string() + ": cannot write " + what);
   }
   std::filesystem::rename(tmp, file);
 }
@@ -325,7 +329,45 @@ void read_input(GLFWwindow* window, InputGlue& glue, const TrainerOptions& o,
     if (pressed_once(window, GLFW_KEY_G, glue.g_down))
       renderer.options().guidance = !renderer.options().guidance;
     if (pressed_once(window, GLFW_KEY_F1, glue.f1_down)) ui.toggle_controls();
+    if (pressed_once(window, GLFW_KEY_F12, glue.f12_down)) glue.save_view = true;
   }
+}
+
+// The view alone (no panels), drawn off-screen at w × h and saved as a PNG: a hidden or covered
+// window's pixels are undefined. Leaves the window's framebuffer bound.
+void save_view(render::Renderer& renderer, const render::RenderSnapshot& snap,
+               const render::Microscope& microscope, int w, int h,
+               const std::filesystem::path& file) {
+  render::OffscreenTarget target(w, h);
+  glViewport(0, 0, w, h);
+  glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  renderer.draw(snap, microscope, w, h);
+  render::save_screenshot(file, w, h);
+  render::OffscreenTarget::unbind();
+}
+
+// What F12's view shows, beside its PNG: the tools' shown poses, the globe's turn and the camera,
+// so the picture can be checked against the geometry (tests/apps/test_trainer_port_view.cpp).
+void write_view_poses(const std::filesystem::path& file, const render::RenderSnapshot& snap,
+                      const render::Microscope& m, double sim_time_s, int w, int h) {
+  const auto xyz = [](const Vec3& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+  nlohmann::json j;
+  j["sim_time_s"] = sim_time_s;
+  j["width"] = w, j["height"] = h;
+  j["microscope"] = {{"field_mm", m.field_mm},
+                     {"focus_z_mm", m.focus_z_mm},
+                     {"working_distance_mm", m.working_distance_mm},
+                     {"centre_mm", xyz(m.centre_mm)}};
+  const Quat& g = snap.globe_rotation;
+  j["globe_rotation_wxyz"] = {g.w(), g.x(), g.y(), g.z()};
+  j["tools"] = nlohmann::json::array();
+  for (const render::ToolView& t : snap.tools)
+    j["tools"].push_back({{"hand", std::string(to_string(t.hand))},
+                          {"tool", std::string(to_string(t.kind))},
+                          {"tip_mm", xyz(t.tip_mm)},
+                          {"shaft", xyz(t.quat.normalized() * Vec3::UnitZ())}});
+  write_json_file(file, j, "the view's poses");
 }
 
 // Closing with drills the database refused: never lose them silently. Beside the database first;
@@ -533,17 +575,26 @@ int run_trainer(const TrainerOptions& o) {
       // After the simulated time, or at the drill's end if it is shorter.
       if (o.screenshot && snap &&
           (status.sim_time_s >= o.after_s || status.state == TrainerState::Ended)) {
-        // Off-screen at the window's size: a hidden or covered window's pixels are undefined.
-        render::OffscreenTarget target(o.width, o.height);
-        glViewport(0, 0, o.width, o.height);
-        glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        renderer.draw(*snap, microscope, o.width, o.height);
-        render::save_screenshot(*o.screenshot, o.width, o.height);
-        render::OffscreenTarget::unbind();
+        save_view(renderer, *snap, microscope, o.width, o.height, *o.screenshot);
         std::printf("screenshot at %.2f s simulated (%.1f s wall): %s\n", status.sim_time_s,
                     wall_s(), o.screenshot->c_str());
         break;
+      }
+      if (glue.save_view && snap) {
+        glue.save_view = false;
+        char name[32];
+        std::snprintf(name, sizeof name, "view-%03d", glue.views_saved + 1);
+        const std::filesystem::path png = o.views_dir / (std::string(name) + ".png");
+        try {  // a folder that refuses the file costs the picture, not the drill
+          save_view(renderer, *snap, microscope, fb_w, fb_h, png);
+          write_view_poses(o.views_dir / (std::string(name) + ".json"), *snap, microscope,
+                           status.sim_time_s, fb_w, fb_h);
+          ++glue.views_saved;
+          std::printf("view saved: %s\n", png.c_str());
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "phaco-trainer: F12: the view was not saved: %s\n", e.what());
+        }
+        glViewport(0, 0, fb_w, fb_h);
       }
       if (snap && o.render) renderer.draw(*snap, microscope, fb_w, fb_h, covered);
 
@@ -560,7 +611,9 @@ int run_trainer(const TrainerOptions& o) {
         ImGui::Render();
         render_panels(renderer, panel_bg, fb_w, fb_h);
         if (o.ui_state && now_ns() - glue.ui_state_ns > 100'000'000) {
-          write_ui_state(*o.ui_state, ui.state_json(*session, session->newest_snapshot()));
+          nlohmann::json state = ui.state_json(*session, session->newest_snapshot());
+          state["views_saved"] = glue.views_saved;
+          write_json_file(*o.ui_state, state);
           glue.ui_state_ns = now_ns();
         }
       }

@@ -23,7 +23,7 @@ usage:
   phaco-trainer ... --screenshot OUT.png [--after SECONDS] [--no-ui]
   phaco-trainer ... --stats OUT.json [--stats-after SECONDS] [--no-render]
   phaco-trainer ... --soak OUT.json [--soak-for SECONDS]
-  phaco-trainer ... --ui-state OUT.json
+  phaco-trainer ... --ui-state OUT.json [--views DIR]
   phaco-trainer --procedure FILE [--procedure-out DIR] [--left DEVICE] [--right DEVICE] ...
   phaco-trainer --help | --version
 
@@ -62,13 +62,17 @@ usage:
   --ui-state    while running, rewrite OUT.json ten times a second with what the trainee sees:
                 the active hand, each tip's height readout, the Result table (for tests that
                 drive the window with xdotool)
+  --views       the folder F12 saves the view to (default: the current one): view-NNN.png, the
+                view without the panels, and view-NNN.json, the tools' tips and shafts, the
+                globe's turn and the microscope it shows
 
 controls: mouse moves the selected hand's tip, only while the pointer is over the view (over a
 panel or outside the window both tools stay put; hold the middle button or Shift to move the
 pointer alone), wheel = depth (0.1 mm a click), left button = grip / ultrasound, right button =
 aspiration; Tab switches hands; a gamepad drives both hands (sticks, triggers = grip/pedal,
 bumpers = deeper); Space pauses; R restarts; G toggles the guidance cues; F1 shows the controls;
-Esc quits. The label by each tip is its height above the tissue under it.
+F12 saves the view (--views); Esc quits. The label by each tip is its height above the tissue
+under it.
 An interactive run remembers the trainee, devices, drill and level it ended with in
 $XDG_CONFIG_HOME/openphaco/trainer.json (default ~/.config/openphaco) and starts with them when the
 command line does not say otherwise.
@@ -109,11 +113,12 @@ std::filesystem::path drill_scenario(const std::string& drill) {
 
 TrainerOptions parse_options(const std::vector<std::string>& raw) {
   const cli::Args a = cli::parse_args(
-      "command line", raw,
-      {"--drill",    "--scenario", "--difficulty",  "--left",         "--right",     "--trainee",
-       "--db",       "--sync-to",  "--size",        "--threads",      "--cache-dir", "--screenshot",
-       "--after",    "--stats",    "--stats-after", "--duration",     "--timeout",   "--soak",
-       "--soak-for", "--ui-state", "--procedure",   "--procedure-out"},
+      "command line", raw, {"--drill",     "--scenario",      "--difficulty",  "--left",
+                            "--right",     "--trainee",       "--db",          "--sync-to",
+                            "--size",      "--threads",       "--cache-dir",   "--screenshot",
+                            "--after",     "--stats",         "--stats-after", "--duration",
+                            "--timeout",   "--soak",          "--soak-for",    "--ui-state",
+                            "--procedure", "--procedure-out", "--views"},
       {"--stereo", "--no-guidance", "--no-ui", "--no-render"}, "phaco-trainer --help");
   if (!a.positional.empty()) {
     throw InputError("unexpected argument '" + a.positional[0] +
@@ -156,6 +161,11 @@ TrainerOptions parse_options(const std::vector<std::string>& raw) {
   if (auto v = a.option("--after")) o.after_s = number("--after", *v, 0, 3600);
   if (auto v = a.option("--stats")) o.stats = *v;
   if (auto v = a.option("--ui-state")) o.ui_state = *v;
+  if (auto v = a.option("--views")) {
+    if (!std::filesystem::is_directory(*v))
+      throw InputError("--views: '" + *v + "' is not a folder (F12 saves the view there)");
+    o.views_dir = *v;
+  }
   if (auto v = a.option("--stats-after")) o.stats_after_s = number("--stats-after", *v, 0.5, 3600);
   if (auto v = a.option("--timeout")) o.timeout_s = number("--timeout", *v, 1, 86400);
   o.stereo = a.flag("--stereo");

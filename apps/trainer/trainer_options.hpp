@@ -38,6 +38,8 @@ struct TrainerOptions {
   std::optional<std::filesystem::path> soak;
   // What the trainee sees (TrainerUi::state_json), rewritten ten times a second while running.
   std::optional<std::filesystem::path> ui_state;
+  // Where F12 saves the view (view-NNN.png, and view-NNN.json with the poses it shows).
+  std::filesystem::path views_dir = ".";
   double soak_for_s = 60.0;
   // The procedure mode (apps/trainer/trainer_procedure.hpp): the procedure file, and where its
   // recording and report go when it is done.

@@ -122,7 +122,9 @@ void controls_window(const Scenario& scenario, bool& open) {
   ImGui::BulletText("clutch: hold the middle button or Shift to move the pointer, not the tool;");
   ImGui::TextUnformatted("    over a panel or outside the window both tools stay where they are");
   ImGui::BulletText("the label by each tip: its height above the tissue under it");
-  ImGui::BulletText("Space: pause   R: restart   G: guidance cues   F1: this help   Esc: quit");
+  ImGui::BulletText(
+      "Space: pause   R: restart   G: guidance cues   F1: this help   F12: save the view   Esc: "
+      "quit");
   ImGui::BulletText("gamepad: sticks move the tips, LB/RB deeper, stick clicks up, triggers grip");
   if (ImGui::Button("Got it (F1 shows this again)")) open = false;
   ImGui::End();

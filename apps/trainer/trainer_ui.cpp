@@ -160,7 +160,8 @@ void TrainerUi::drill_panel(TrainerSession& session, UiAction& action) {
   }
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-  ImGui::TextWrapped("Tab: other hand  Space: pause  R: restart  G: guidance  F1: controls");
+  ImGui::TextWrapped(
+      "Tab: other hand  Space: pause  R: restart  G: guidance  F1: controls  F12: save view");
   ImGui::PopStyleColor();
   ImGui::End();
 }

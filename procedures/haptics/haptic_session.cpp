@@ -128,8 +128,12 @@ void HapticSession::tick(const TickInfo& info) {
     const DeviceHealth health = device.health(now);
     Vec3 force = Vec3::Zero();
     if (h.have_sample && (health == DeviceHealth::Ok || health == DeviceHealth::Ended)) {
-      const haptic_model::HapticForce f =
-          haptic_model::haptic_tick(tool, h.sample.pos_mm, h.velocity, config_.model, *h.state);
+      // The shaft the device holds (local +z, tip → handle): the port's lever (issue 20 item 2).
+      const Vec3 shaft = h.sample.quat.coeffs().allFinite() && h.sample.quat.norm() > 1e-9
+                             ? Vec3(h.sample.quat.normalized() * Vec3::UnitZ())
+                             : Vec3::Zero();
+      const haptic_model::HapticForce f = haptic_model::haptic_tick(
+          tool, h.sample.pos_mm, h.velocity, shaft, config_.model, *h.state);
       force = f.force_mn;
       if (f.clamped) h.clamped.fetch_add(1, std::memory_order_relaxed);
       if (f.input_rejected) h.rejected.fetch_add(1, std::memory_order_relaxed);

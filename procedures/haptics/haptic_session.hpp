@@ -6,7 +6,8 @@
 //     non-finite or out-of-workspace sample is dropped and counted, grip/pedal clamped)
 //     ──▶ SPSC ring ──▶ the simulation drains it (newest_pose)
 //   takes the newest local model, if one was published (triple buffer, acquire)
-//   computes the force from it alone (systems/haptic_model: proxy, local nodes, grasp, lens)
+//   computes the force from it alone (systems/haptic_model: proxy, local nodes, grasp, lens, and
+//   the port, against the device's own shaft)
 //   writes the force to the device, zero when the device is silent or failed (its tool frozen)
 //
 // and never waits for the simulation: a stalled simulation leaves the last model running. The

@@ -13,6 +13,7 @@
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/haptic_lens_contacts.hpp"
 #include "procedures/scene/scene.hpp"
+#include "procedures/scene/tool_ports.hpp"
 
 namespace phaco {
 namespace {
@@ -31,6 +32,11 @@ void clear_tool(HapticTool& t) {
   t.sphere_count = 0;
   t.cut_force_mn = 0;
   t.held = {};
+  t.port_present = false;
+}
+
+std::array<float, 3> floats(const Vec3& v) {
+  return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
 }
 
 // Every particle once, for a capsule integrated whole (no active set: no locality to keep).
@@ -212,6 +218,24 @@ void fill_capsule(const Scene& scene, Entity capsule, const HapticPublishSetting
 
 }  // namespace
 
+void fill_haptic_port(const PortsRecord& ports, size_t index, HapticTool& t) {
+  t.port_present = false;
+  if (index >= kMaxPortTools) return;
+  const int at = ports.globe.tools[index].port;
+  if (at < 0 || static_cast<size_t>(at) >= ports.ports.size()) return;
+  const EyePort& port = ports.ports[static_cast<size_t>(at)];
+  // The tunnel turns with the globe about its centre (systems/tool_eye), as the solve left it.
+  const Eigen::Matrix3d rot = ports.globe.rotation.normalized().toRotationMatrix();
+  const Vec3& gc = ports.eye.globe_centre_mm;
+  t.port_present = true;
+  t.port_centre_mm = floats(gc + rot * (port.centre_mm - gc));
+  t.port_axis = floats(rot * port.axis);
+  t.port_width_dir = floats(rot * port.width_dir);
+  t.port_half_width_mm = static_cast<float>(0.5 * port.width_mm);
+  t.port_tunnel_length_mm = static_cast<float>(port.tunnel_length_mm);
+  t.port_stiffness_mn_per_mm = static_cast<float>(ports.stiffness.tunnel_mn_mm);
+}
+
 double haptic_tip_radius_mm(const Scene& scene, uint8_t tool_kind) {
   switch (static_cast<ToolKind>(tool_kind)) {
     case ToolKind::PhacoProbe:
@@ -251,7 +275,9 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
   const bool has_lens = scene.body(BodyPart::Lens) || scene.body(BodyPart::LensSurface);
   const bool sculptable_lens = has_sculptable_lens(scene);
   if (has_capsule_physics) track_capsule_particles(scene, *capsule, settings, scratch);
-  for (Entity e : scene.tools) {
+  const PortsRecord* ports = ports_record(scene);
+  for (size_t index = 0; index < scene.tools.size(); ++index) {
+    const Entity e = scene.tools[index];
     const Tool& tool = *scene.world.get<Tool>(e);
     HapticTool& t = model.tools[static_cast<size_t>(tool.hand) % kHapticTools];
     const ToolState& pose = *scene.world.get<ToolState>(e);
@@ -285,6 +311,7 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
           static_cast<float>(scene.params.get("lens.posterior_half_thickness_mm"));
       t.lens_stiffness_mn_per_mm = static_cast<float>(settings.lens_stiffness_mn_mm);
     }
+    if (ports) fill_haptic_port(*ports, index, t);
   }
   model.published_ns = now_ns();
 }
@@ -294,7 +321,7 @@ SystemDesc haptic_publish_system(Scene& scene) {
   auto scratch = std::make_shared<HapticPublishScratch>();
   return {.name = "publish_haptics",
           .phase = Phase::Publish,
-          .reads = {"tools.pose", "tools.grasp", "tools.held", "capsule.particles",
+          .reads = {"tools.pose", "tools.grasp", "tools.held", "tools.ports", "capsule.particles",
                     "capsule.springs", "capsule.solver", "capsule.settings", "capsule.triangles",
                     "capsule.cutting", "lens.sculpting", "lens.tets", "lens.cells"},
           .writes = {"haptics.model"},

@@ -14,6 +14,9 @@
 //            lens keeps its shape; a lens the tools sculpt or break (lens.model tets or fragments)
 //            is published instead as spheres of its material near each tip, with the tool's held
 //            fragment (procedures/scene/haptic_lens_contacts, issue 19 item 5)
+//   port     the corneal port the tool is in (procedures/scene/tool_ports, when the ports are
+//            measured or constrained), turned with the globe as this frame's equilibrium left it,
+//            with the tunnel's stiffness (issue 20 item 2)
 //
 // Cost: re-binning the active set (systems/point_bins), then per tool the bins within the contact
 // radius, a breadth-first walk of the ball and of its triangle fans, and a ≈ 62 KiB model write:
@@ -21,7 +24,8 @@
 // keep: the first frame's binning, a capsule without an active set, and, with capsule.cutting off,
 // the patch (no vertex-to-triangle index). Reads: tools.pose, tools.grasp, capsule.particles,
 // capsule.springs, capsule.solver (the active set), capsule.settings, capsule.triangles,
-// capsule.cutting, tools.held, lens.sculpting, lens.tets, lens.cells. Writes: haptics.model.
+// capsule.cutting, tools.held, tools.ports, lens.sculpting, lens.tets, lens.cells. Writes:
+// haptics.model.
 #include <cstdint>
 #include <vector>
 
@@ -33,6 +37,7 @@
 namespace phaco {
 
 struct Scene;
+struct PortsRecord;
 
 struct HapticPublishSettings {
   uint32_t active_hops = 5;           // seed 003 §III.D
@@ -61,6 +66,10 @@ HapticPublishSettings haptic_publish_settings(const Scene& scene);
 // tool is rewritten; `sequence`, `frame`, `sim_time_s` and `published_ns` are set too.
 void build_haptic_model(const Scene& scene, const HapticPublishSettings& settings,
                         HapticPublishScratch& scratch, HapticModel& model);
+
+// The port tool `index` (scene.tools order) is in, from the ports' record, into `t`'s port_*
+// fields (port_present false when it is in none).
+void fill_haptic_port(const PortsRecord& ports, size_t index, HapticTool& t);
 
 // The frame's system: builds into scene.haptics->model_slot() and publishes it.
 SystemDesc haptic_publish_system(Scene& scene);

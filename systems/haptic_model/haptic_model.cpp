@@ -61,7 +61,7 @@ void init_sides(HapticSlot& s, HapticScratch& sc) {
 
 // One tick of one model: contacts, nodes, proxy, force.
 void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& dev_vel,
-               const HapticSettings& st, uint64_t& resets) {
+               const Vec3& shaft, const HapticSettings& st, uint64_t& resets) {
   const HapticTool& m = s.model;
   s.active = 0, s.penetration_mm = 0, s.lens_depth_mm = 0, s.sphere_depth_mm = 0, s.iterations = 0;
   const double dt = st.dt_s;
@@ -91,9 +91,16 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
 
   // 3. proxy.
   Vec3 p;
+  Vec3 port_force = Vec3::Zero();  // while grasping: the port's own proxy's pull
   if (grasped < m.node_count) {
     p = node(s, grasped);
     s.active |= kTermGrasp;
+    Planes port;
+    const uint32_t n = detail::add_port_planes(m, dev, shaft, r, port, 0);
+    if (n > 0) {
+      port_force = kc * (solve_proxy(dev, dev, kc, r, port, n) - dev);
+      if (port_force.squaredNorm() > 0) s.active |= kTermPort;
+    }
   } else {
     Planes planes;
     uint32_t np = 0;
@@ -110,6 +117,8 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
       }
     };
     build(dev);
+    const uint32_t first_port = np;
+    np = detail::add_port_planes(m, dev, shaft, r, planes, np);
     const uint32_t first_sphere = np;
     if (m.sphere_count > 0) {
       Planes rigid;
@@ -123,6 +132,8 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
       s.surface_proxy = dev;
     }
     p = solve_proxy(dev, s.proxy, kc, r, planes, np);
+    for (uint32_t j = first_port; j < first_sphere; ++j)
+      if (r - planes[j].normal.dot(p - planes[j].point) > 0) s.active |= kTermPort;
     for (uint32_t j = first_sphere; j < np; ++j) {
       const double pen = r - planes[j].normal.dot(p - planes[j].point);
       if (!(pen > 0)) continue;
@@ -149,6 +160,7 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
     const double mag = s.force.norm(), limit = m.grasp_limit_mn;
     if (mag > limit) s.force *= limit / mag;
   }
+  s.force += port_force;  // the flap's bound is the flap's; the tunnel pushes on the shaft
   // A held fragment hangs from the proxy (held_load.cpp); its load goes to the hand.
   if (m.held.held) {
     s.force += detail::held_load(m.held, p, s.proxy_velocity, st, s.held);
@@ -277,8 +289,16 @@ void adopt_model(const HapticTool& model, HapticToolState& state, const HapticSe
 HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
                         const Vec3& device_vel_mm_s, const HapticSettings& settings,
                         HapticToolState& state) {
+  return haptic_tick(model, device_pos_mm, device_vel_mm_s, Vec3::Zero(), settings, state);
+}
+
+HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
+                        const Vec3& device_vel_mm_s, const Vec3& device_shaft_dir,
+                        const HapticSettings& settings, HapticToolState& state) {
   HapticForce out;
   ++state.ticks;
+  // A shaft that is not a direction (no orientation, or a bad sample) only loses the port.
+  const Vec3 shaft = finite(device_shaft_dir) ? device_shaft_dir : Vec3::Zero();
   if (!finite(device_pos_mm) || !finite(device_vel_mm_s)) {
     ++state.inputs_rejected;
     out.input_rejected = true;
@@ -289,13 +309,13 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
       (!nw.live || model.present != nw.model.present || model.node_count != nw.model.node_count ||
        model.triangle_count != nw.model.triangle_count ||
        model.grasped_node != nw.model.grasped_node || model.sphere_count != nw.model.sphere_count ||
-       model.held.held != nw.model.held.held)) {
+       model.held.held != nw.model.held.held || model.port_present != nw.model.port_present)) {
     adopt_model(model, state, settings);
   }
   HapticSlot& cur = state.slot[state.newest];
   HapticSlot& old = state.slot[state.newest ^ 1];
   const Vec3 cur_before = cur.force, old_before = old.force;
-  tick_slot(cur, state.scratch, device_pos_mm, device_vel_mm_s, settings, state.slot_resets);
+  tick_slot(cur, state.scratch, device_pos_mm, device_vel_mm_s, shaft, settings, state.slot_resets);
   Vec3 f = cur.force;
   out.active = cur.active;
   double natural = (cur.force - cur_before).norm();  // the model's own change this tick
@@ -303,7 +323,8 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
   if (old.live && (state.blending || state.slewing)) {
     // The settled model keeps ticking until the output has caught up: its own change is the
     // natural rate the slew bound allows on top (the new model's first ticks are not).
-    tick_slot(old, state.scratch, device_pos_mm, device_vel_mm_s, settings, state.slot_resets);
+    tick_slot(old, state.scratch, device_pos_mm, device_vel_mm_s, shaft, settings,
+              state.slot_resets);
     natural = (old.force - old_before).norm();
   }
   if (state.blending && old.live) {

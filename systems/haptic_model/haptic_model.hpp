@@ -4,7 +4,8 @@
 // force to send to the device, without waiting for the simulation. docs/haptic_model.md.
 //
 //   device D ──k_c, b_c (virtual coupling)── proxy P ──k_p── patch triangles ── springs ── anchors
-//                                                   └─k_f── lens (seed 003 §E.5: F = −k_f·d)
+//                                                   ├─k_f── lens (seed 003 §E.5: F = −k_f·d)
+//                                                   └─k_t── port: the shaft's line to the tunnel
 //   grasp: the grasped node IS the proxy; the user feels its springs (the flap's spring)
 //
 // Per tick, per model being integrated (two during a crossfade):
@@ -29,6 +30,11 @@
 // planes tangent to each sphere facing the proxy, shared like the patch's facets, each with its
 // stiffness and, under ultrasound, a force bound (a plane's energy turns linear past it: the tip
 // cuts through). A held fragment (held_load.cpp) adds its load to step 4's force.
+// Port (issue 20 item 2, port_planes.cpp): the tunnel the tool is in enters step 3 as planes on
+// the proxy's shaft line, the shaft the device's own (its orientation this tick), so a hand that
+// levers against the port feels the tunnel's spring at once and one that pivots about its centre
+// feels nothing; while grasping, the same planes give a proxy of their own whose coupling force is
+// added.
 // A new model is crossfaded in (both models ticked, forces mixed linearly over blend_ms, the
 // output's change per tick beyond the models' own bounded by blend_max_step_mn until it has caught
 // up), so the force is continuous; a stalled simulation leaves the last model running.
@@ -81,7 +87,8 @@ enum HapticTerm : uint8_t {
   kTermBlend = 8,
   kTermSpheres = 16,  // lens material (spheres) pressed
   kTermCut = 32,      // ... and its reaction at the ultrasound cut bound
-  kTermHeld = 64      // a held fragment's load
+  kTermHeld = 64,     // a held fragment's load
+  kTermPort = 128     // the port's tunnel pressed by the shaft
 };
 
 struct HapticForce {
@@ -182,10 +189,15 @@ struct HapticToolState {
 // the proxy carried over from the current one (or the model's tip), and the crossfade begins.
 void adopt_model(const HapticTool& model, HapticToolState& state, const HapticSettings& settings);
 
-// One tick. `model` is the newest model as last given to adopt_model (the state integrates its own
-// copy; if `model` visibly differs from it — presence, node, triangle or sphere count, grasped
-// node, held fragment — it is adopted first). Device position mm, velocity mm/s (a NaN/inf sample:
-// zero force, state kept).
+// One tick; `device_shaft_dir` is the device's shaft (tip → handle, any length; zero: a device
+// without orientation, which feels no port). `model` is the newest model as last given to
+// adopt_model (the state integrates its own copy; if `model` visibly differs from it — presence,
+// node, triangle or sphere count, grasped node, held fragment — it is adopted first). Device
+// position mm, velocity mm/s (a NaN/inf sample: zero force, state kept).
+HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
+                        const Vec3& device_vel_mm_s, const Vec3& device_shaft_dir,
+                        const HapticSettings& settings, HapticToolState& state);
+// The same without the device's orientation (no port term).
 HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
                         const Vec3& device_vel_mm_s, const HapticSettings& settings,
                         HapticToolState& state);

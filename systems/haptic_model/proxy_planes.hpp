@@ -21,7 +21,8 @@ struct Plane {
 // Sphere contacts a tick keeps (the deepest): a 0.45 mm tip pressed into a level-3 lens (cells of
 // ≈ 0.1 mm radius) meets up to about a hundred; with 32 the set changed as the tip slid.
 inline constexpr uint32_t kMaxSphereContacts = 128;
-inline constexpr uint32_t kMaxPlanes = kHapticMaxContacts + 1 + kMaxSphereContacts;
+inline constexpr uint32_t kMaxPortPlanes = 4;  // through the slit, both ways; across, beyond ±w/2
+inline constexpr uint32_t kMaxPlanes = kHapticMaxContacts + 1 + kMaxSphereContacts + kMaxPortPlanes;
 using Planes = std::array<Plane, kMaxPlanes>;
 
 // Appends the planes of the tool's published spheres (components/haptic_model.hpp) that the tip
@@ -41,6 +42,18 @@ using Planes = std::array<Plane, kMaxPlanes>;
 // tip presses or cuts.
 uint32_t add_sphere_planes(const HapticTool& m, const Vec3& outside, const Vec3& device, double r,
                            double rigid_k, Planes& planes, uint32_t count, double& deepest);
+
+// Appends the planes of the tool's port (components/haptic_model.hpp, port_*) for a proxy whose
+// shaft runs along `shaft` (unit, tip → handle: the device's): systems/tool_eye's translational
+// tunnel spring, ½k_t·(|δ_w| − w/2)₊² + ½k_t·δ_h², with δ the shaft line's offset from the port's
+// centre across (w) and through (h) the slit. For a fixed shaft δ is linear in the proxy P,
+// δ_e = g_e·(c − P) with g_e = e − (d·e)·d, so each side of each direction is one plane of normal
+// ±g_e/|g_e| and stiffness k_t·|g_e|² (the tip radius r cancelled out of the plane's point). The
+// springs fade in as the device's tip goes from the port's centre to half a tunnel past it, so
+// entering or leaving the port is continuous. Returns the new count (unchanged: no port, no
+// shaft, or the tip outside the tunnel).
+uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& shaft, double r,
+                         Planes& planes, uint32_t count);
 
 // A held fragment's load on the tip this tick (components/held_fragment.hpp): advances the
 // fragment (backward Euler, unconditionally stable at any mass) hanging from the proxy P moving at

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/apps/trainer_driver.hpp"
 #include "tests/support/environment.hpp"
 #include "tests/support/shell.hpp"
 
@@ -27,24 +28,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using test::shell;
 
 // The steps, as a trainee would take them; each `snap NAME` copies the newest UI state.
-constexpr const char* kScript = R"(set -u
-T="$1"; D="$2"; shift 2
+constexpr const char* kScript = R"(
 "$T" --drill capsulorhexis --duration 10 --size 1280x720 --ui-state "$D/state.json" --timeout 300 \
   "$@" > "$D/trainer.log" 2>&1 &
 P=$!
-for i in $(seq 1200); do
-  grep -qs '"state": "running"' "$D/state.json" && break
-  kill -0 $P 2>/dev/null || { echo "the trainer exited early"; cat "$D/trainer.log"; exit 1; }
-  sleep 0.1
-done
-# A step is taken when the state shows it (a software-rendered frame under load may take a second).
-wait_for() {
-  for i in $(seq 300); do grep -qs "$1" "$D/state.json" && return 0; sleep 0.1; done
-  echo "timed out waiting for $1"
-}
+started
 snap() { sleep 0.5; cp "$D/state.json" "$D/$1.json"; }
 xdotool mousemove 640 400; wait_for '"controls_shown": true'; snap intro
 xdotool key F1; wait_for '"controls_shown": false'; snap s0
@@ -88,24 +78,13 @@ double distance(const json& a, const json& b) {
 }
 
 TEST(TrainerInput, ClutchDepthReadoutTabAndResultAsATraineeUsesThem) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "a real-time drill under ASan and llvmpipe; the Release pass runs it";
-#endif
-  PHACO_REQUIRE_ENVIRONMENT(
-      shell("command -v xvfb-run && command -v xdotool").code == 0,
-      "xvfb-run or xdotool not found (scripts/install-deps.sh installs them)");
+  PHACO_REQUIRE_TRAINER_DRIVER();
   const fs::path dir =
       fs::temp_directory_path() / ("phaco-trainer-input-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  std::ofstream(dir / "steps.sh") << kScript;
-  const char* cache = std::getenv("PHACO_CACHE_DIR");
-  const std::string cmd = "xvfb-run -a -s '-screen 0 1280x800x24' bash " +
-                          (dir / "steps.sh").string() + " " + PHACO_TRAINER_BIN + " " +
-                          dir.string() +
-                          (cache ? std::string(" --cache-dir ") + cache : std::string());
-  const test::ShellResult r = shell(cmd);
-  ASSERT_EQ(r.code, 0) << cmd << "\n" << r.output;
+  const test::ShellResult r = test::drive_trainer(PHACO_TRAINER_BIN, dir, kScript);
+  ASSERT_EQ(r.code, 0) << r.output;
   ASSERT_NE(r.output.find("trainer exit 0"), std::string::npos) << r.output;
 
   const json intro = read_json(dir / "intro.json"), s0 = read_json(dir / "s0.json"),

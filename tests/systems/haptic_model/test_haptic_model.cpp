@@ -467,12 +467,25 @@ TEST(HapticModel, TicksAndAdoptsDoNotAllocate) {
                  .drag_mn_s_per_mm = 0.1f,
                  .weight_mn = {0, 0, -0.03f},
                  .hold_limit_mn = 11.0f};
+  // Both through a corneal port (issue 20 item 2), levered against it.
+  for (HapticTool* t : {sheet.get(), grasped.get()}) {
+    t->port_present = true;
+    t->port_centre_mm = {4.0f, 0.0f, 2.0f};
+    t->port_axis = {-1.0f, 0.0f, 0.0f};
+    t->port_width_dir = {0.0f, 1.0f, 0.0f};
+    t->port_half_width_mm = 1.2f, t->port_tunnel_length_mm = 1.75f;
+    t->port_stiffness_mn_per_mm = 200.0f;
+  }
   auto st = fresh(*sheet, s);
   const uint64_t before = g_allocations.load(std::memory_order_relaxed);
+  uint8_t terms = 0;
   for (int k = 0; k < 300; ++k) {
     if (k % 30 == 0) adopt_model(k % 60 ? *grasped : *sheet, *st, s);
-    haptic_tick(st->newest_model(), Vec3(0.1, 0.1, 0.1 - 0.001 * k), Vec3::Zero(), s, *st);
+    terms |= haptic_tick(st->newest_model(), Vec3(0.1, 0.1, 0.1 - 0.001 * k), Vec3::Zero(),
+                         Vec3(1.0, 0.0, 0.5), s, *st)
+                 .active;
   }
+  EXPECT_TRUE(terms & kTermPort);
   EXPECT_EQ(g_allocations.load(std::memory_order_relaxed), before);
   EXPECT_EQ(st->models_adopted, 11u);
 }
