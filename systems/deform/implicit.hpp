@@ -91,7 +91,14 @@ namespace phaco::deform {
 enum class CgOperator : uint8_t { Assembled, MatrixFree };
 enum class PredictorStiffness : uint8_t { Isotropic, FrozenJacobian };
 // CG preconditioners of implicit Euler (implicit_solver.hpp, docs/implicit_and_active.md).
-enum class Preconditioner : uint8_t { Jacobi, BlockJacobi, IncompleteCholesky, TwoLevel };
+enum class Preconditioner : uint8_t {
+  Jacobi,
+  BlockJacobi,
+  IncompleteCholesky,
+  TwoLevel,
+  Deflation,
+  Balancing
+};
 
 struct ImplicitSettings {
   double cg_tolerance = 1.0e-6;  // relative residual
