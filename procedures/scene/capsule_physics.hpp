@@ -15,7 +15,7 @@
 //   capsule.active_set   on | off                               (default on)
 //   capsule.preconditioner  jacobi | block_jacobi | incomplete_cholesky | two_level |
 //                        deflation | balancing: implicit Euler's CG preconditioner (default
-//                        deflation; systems/deform/implicit_solver.hpp)
+//                        block_jacobi; systems/deform/implicit_solver.hpp)
 //   capsule.cutting      on | off, capsule.tear_rule flap_force | most_stressed_spring
 //                        (procedures/scene/capsule_cutting.hpp)
 #include <initializer_list>

@@ -29,7 +29,7 @@
 // (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each particle, preconditioned by
 // settings.preconditioner (implicit_solver.hpp): Jacobi, 3×3 block-Jacobi, incomplete Cholesky
 // of the assembled matrix, a two-level smoothed-aggregation cycle (Tamstorf, Jones & McCormick
-// 2015), or deflation (the default) / balancing on unsmoothed aggregates (Tang et al. 2009).
+// 2015), or deflation / balancing on unsmoothed aggregates (Tang et al. 2009).
 // Incomplete Cholesky is refactored when the unknown set or the topology changes, the
 // two-level hierarchy after a topology change or a large change of the set; otherwise both are
 // reused stale (still SPD, so CG stays valid; only its speed depends on staleness).
@@ -107,9 +107,9 @@ struct ImplicitSettings {
   bool warm_start = true;
   CgOperator cg_operator =
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
-  // Deflation: ≤ 40 CG iterations per frame on the capsulorhexis and no slower than block-Jacobi
-  // (measured, docs/implicit_and_active.md).
-  Preconditioner preconditioner = Preconditioner::Deflation;
+  // Block-Jacobi: Deflation needs ≤ 40 CG iterations per frame at about its cost, but its answer
+  // at the same tolerance spiked a tear frame's forceps force (docs/implicit_and_active.md).
+  Preconditioner preconditioner = Preconditioner::BlockJacobi;
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a
   // small active set pays no threading overhead. Measured (docs/implicit_and_active.md).

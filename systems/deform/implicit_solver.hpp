@@ -25,7 +25,7 @@
 //                       damped block-Jacobi step, Galerkin coarse operator Pᵀ·A·P factorised by
 //                       sparse Cholesky; applied as a symmetric cycle (block-Jacobi pre-smooth,
 //                       coarse correction, the same post-smooth), so it is SPD and CG stays valid.
-//   Deflation           (the default) and Balancing: the same kind of two-level method on
+//   Deflation           and Balancing: the same kind of two-level method on
 //                       unsmoothed aggregates, built to cost little per iteration on the small
 //                       active sets (implicit_deflation.cpp): one coarse solve and one pass over
 //                       A·P₀ per iteration instead of TwoLevel's three operator products.
