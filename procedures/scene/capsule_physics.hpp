@@ -13,9 +13,9 @@
 //   capsule.pretension   cotangent | uniform_prestretch         (default cotangent: isotropic
 //                        tension on any mesh, docs/membrane_accuracy.md)
 //   capsule.active_set   on | off                               (default on)
-//   capsule.preconditioner  jacobi | block_jacobi | incomplete_cholesky | two_level: implicit
-//                        Euler's CG preconditioner (default block_jacobi;
-//                        systems/deform/implicit_solver.hpp)
+//   capsule.preconditioner  jacobi | block_jacobi | incomplete_cholesky | two_level |
+//                        deflation | balancing: implicit Euler's CG preconditioner (default
+//                        block_jacobi; systems/deform/implicit_solver.hpp)
 //   capsule.cutting      on | off, capsule.tear_rule flap_force | most_stressed_spring
 //                        (procedures/scene/capsule_cutting.hpp)
 #include <initializer_list>

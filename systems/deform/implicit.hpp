@@ -28,8 +28,9 @@
 // The system is solved by preconditioned CG, relative tolerance settings.cg_tolerance
 // (‖r‖ ≤ tol·‖b‖), warm-started from the previous step's Δv of each particle, preconditioned by
 // settings.preconditioner (implicit_solver.hpp): Jacobi, 3×3 block-Jacobi, incomplete Cholesky
-// of the assembled matrix, or a two-level smoothed-aggregation cycle (Tamstorf, Jones & McCormick
-// 2015). Incomplete Cholesky is refactored when the unknown set or the topology changes, the
+// of the assembled matrix, a two-level smoothed-aggregation cycle (Tamstorf, Jones & McCormick
+// 2015), or deflation / balancing on unsmoothed aggregates (Tang et al. 2009).
+// Incomplete Cholesky is refactored when the unknown set or the topology changes, the
 // two-level hierarchy after a topology change or a large change of the set; otherwise both are
 // reused stale (still SPD, so CG stays valid; only its speed depends on staleness).
 // Two operators: an assembled row-major sparse matrix whose pattern is built once per unknown set
@@ -91,7 +92,14 @@ namespace phaco::deform {
 enum class CgOperator : uint8_t { Assembled, MatrixFree };
 enum class PredictorStiffness : uint8_t { Isotropic, FrozenJacobian };
 // CG preconditioners of implicit Euler (implicit_solver.hpp, docs/implicit_and_active.md).
-enum class Preconditioner : uint8_t { Jacobi, BlockJacobi, IncompleteCholesky, TwoLevel };
+enum class Preconditioner : uint8_t {
+  Jacobi,
+  BlockJacobi,
+  IncompleteCholesky,
+  TwoLevel,
+  Deflation,
+  Balancing
+};
 
 struct ImplicitSettings {
   double cg_tolerance = 1.0e-6;  // relative residual
@@ -99,6 +107,8 @@ struct ImplicitSettings {
   bool warm_start = true;
   CgOperator cg_operator =
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
+  // Block-Jacobi: Deflation needs ≤ 40 CG iterations per frame at about its cost, but its answer
+  // at the same tolerance spiked a tear frame's forceps force (docs/implicit_and_active.md).
   Preconditioner preconditioner = Preconditioner::BlockJacobi;
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a

@@ -26,13 +26,18 @@ std::string_view to_string(Preconditioner p) {
       return "incomplete_cholesky";
     case Preconditioner::TwoLevel:
       return "two_level";
+    case Preconditioner::Deflation:
+      return "deflation";
+    case Preconditioner::Balancing:
+      return "balancing";
   }
   return "jacobi";
 }
 
 std::optional<Preconditioner> parse_preconditioner(std::string_view s) {
-  for (Preconditioner p : {Preconditioner::Jacobi, Preconditioner::BlockJacobi,
-                           Preconditioner::IncompleteCholesky, Preconditioner::TwoLevel})
+  for (Preconditioner p :
+       {Preconditioner::Jacobi, Preconditioner::BlockJacobi, Preconditioner::IncompleteCholesky,
+        Preconditioner::TwoLevel, Preconditioner::Deflation, Preconditioner::Balancing})
     if (to_string(p) == s) return p;
   return std::nullopt;
 }
@@ -75,55 +80,6 @@ void for_rows(uint32_t rows, const ImplicitSettings& settings, Fn&& fn) {
                [&fn](uint32_t b, uint32_t e, int) { fn(b, e); });
 }
 
-// y_u = w·D_u⁻¹·r_u per unknown (block inverse), or y_u += w·D_u⁻¹·r_u.
-void apply_block_inverse(std::span<const Sym3> inverse, const double* r, double* y, double w,
-                         bool accumulate, const ImplicitSettings& settings) {
-  for_rows(static_cast<uint32_t>(inverse.size()), settings, [&](uint32_t b, uint32_t e) {
-    for (uint32_t u = b; u < e; ++u) {
-      const Sym3& k = inverse[u];
-      const double r0 = r[3 * u], r1 = r[3 * u + 1], r2 = r[3 * u + 2];
-      const double z0 = w * (k[0] * r0 + k[1] * r1 + k[2] * r2);
-      const double z1 = w * (k[1] * r0 + k[3] * r1 + k[4] * r2);
-      const double z2 = w * (k[2] * r0 + k[4] * r1 + k[5] * r2);
-      if (accumulate)
-        y[3 * u] += z0, y[3 * u + 1] += z1, y[3 * u + 2] += z2;
-      else
-        y[3 * u] = z0, y[3 * u + 1] = z1, y[3 * u + 2] = z2;
-    }
-  });
-}
-
-// Aggregates of the block graph (Vaněk, Mandel & Brezina 1996, phases 1–3): a node whose
-// neighbours are all free seeds an aggregate of itself and them; leftovers join a neighbouring
-// aggregate; what is still left forms its own. Deterministic: nodes in index order.
-uint32_t aggregate(const BlockPattern& pattern, std::vector<uint32_t>& aggregate_of) {
-  const uint32_t n = pattern.rows();
-  aggregate_of.assign(n, kNotUnknown);
-  uint32_t count = 0;
-  for (uint32_t u = 0; u < n; ++u) {
-    bool free = true;
-    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1] && free; ++b)
-      free = aggregate_of[pattern.col[b]] == kNotUnknown;
-    if (!free) continue;
-    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b)
-      aggregate_of[pattern.col[b]] = count;
-    ++count;
-  }
-  std::vector<uint32_t> joined(aggregate_of);
-  for (uint32_t u = 0; u < n; ++u) {
-    if (aggregate_of[u] != kNotUnknown) continue;
-    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b)
-      if (aggregate_of[pattern.col[b]] != kNotUnknown) {
-        joined[u] = aggregate_of[pattern.col[b]];
-        break;
-      }
-  }
-  aggregate_of.swap(joined);
-  for (uint32_t u = 0; u < n; ++u)
-    if (aggregate_of[u] == kNotUnknown) aggregate_of[u] = count++;
-  return count;
-}
-
 // Spectral radius of D⁻¹A by a few power iterations (an estimate from below; the smoother's
 // weight 4/(3ρ) leaves room up to the 2/ρ where damped Jacobi stops converging).
 double estimate_spectral_radius(const ImplicitCache& cache, std::span<const Sym3> inverse) {
@@ -159,36 +115,25 @@ void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
   // near-null space per axis. Row u of P touches the aggregates of u's neighbours:
   // P_uJ = δ(aggregate(u), J)·I − ω·D_u⁻¹·Σ_{w∈J} A_uw.
   std::vector<uint32_t> slot(na, kNotUnknown);
-  std::vector<Block3> sum;  // per aggregate the row touches: Σ_{w∈J} A_uw
+  std::vector<Sym3> sum;  // per aggregate the row touches: Σ_{w∈J} A_uw
   state.p_begin.assign(n + 1, 0);
   state.p_aggregate.clear();
   state.p_block.clear();
   for (uint32_t u = 0; u < n; ++u) {
     const size_t first = state.p_aggregate.size();
-    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
-      const uint32_t agg = aggregate_of[pattern.col[b]];
-      if (slot[agg] == kNotUnknown) {
-        slot[agg] = static_cast<uint32_t>(state.p_aggregate.size() - first);
-        state.p_aggregate.push_back(agg);
-        sum.push_back({});
-      }
-      Block3& s = sum[slot[agg]];
-      for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) s[3 * a + c] += sym_at(blocks[b], a, c);
-    }
+    sum_row_by_aggregate(pattern, blocks.data(), aggregate_of, u, slot, state.p_aggregate, sum);
     const Sym3& dinv = state.inverse_block[u];
     for (size_t t = first; t < state.p_aggregate.size(); ++t) {
       const uint32_t agg = state.p_aggregate[t];
-      const Block3& s = sum[t - first];
+      const Sym3& s = sum[t - first];
       Block3 pb;
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) {
           double v = 0.0;
-          for (int q = 0; q < 3; ++q) v += sym_at(dinv, a, q) * s[3 * q + c];
+          for (int q = 0; q < 3; ++q) v += sym_at(dinv, a, q) * sym_at(s, q, c);
           pb[3 * a + c] = (agg == aggregate_of[u] && a == c ? 1.0 : 0.0) - omega * v;
         }
       state.p_block.push_back(pb);
-      slot[agg] = kNotUnknown;
     }
     sum.clear();
     state.p_begin[u + 1] = static_cast<uint32_t>(state.p_aggregate.size());
@@ -199,6 +144,7 @@ void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
   using Triplet = Eigen::Triplet<double>;
   std::vector<Triplet> entries;
   std::vector<uint32_t> touched;
+  std::vector<Block3> ap_sum;  // per aggregate the row touches: (A·P)_uJ
   for (uint32_t u = 0; u < n; ++u) {
     touched.clear();
     for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
@@ -208,9 +154,9 @@ void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
         if (slot[agg] == kNotUnknown) {
           slot[agg] = static_cast<uint32_t>(touched.size());
           touched.push_back(agg);
-          sum.push_back({});
+          ap_sum.push_back({});
         }
-        Block3& s = sum[slot[agg]];
+        Block3& s = ap_sum[slot[agg]];
         const Block3& p = state.p_block[pb];
         for (int a = 0; a < 3; ++a)
           for (int c = 0; c < 3; ++c)
@@ -224,7 +170,7 @@ void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
       for (size_t t = 0; t < touched.size(); ++t) {
         const uint32_t col_agg = touched[t];
         if (col_agg > row_agg) continue;
-        const Block3& ap = sum[t];
+        const Block3& ap = ap_sum[t];
         for (int a = 0; a < 3; ++a)
           for (int c = 0; c < 3; ++c) {
             if (row_agg == col_agg && c > a) continue;
@@ -234,7 +180,7 @@ void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
       }
     }
     for (uint32_t agg : touched) slot[agg] = kNotUnknown;
-    sum.clear();
+    ap_sum.clear();
   }
   Eigen::SparseMatrix<double> coarse(3 * Eigen::Index(na), 3 * Eigen::Index(na));
   coarse.setFromTriplets(entries.begin(), entries.end());
@@ -245,9 +191,87 @@ void build_two_level(const ImplicitCache& cache, PreconditionerState& state) {
   state.coarse_solution.resize(3 * Eigen::Index(na));
 }
 
-// Maps today's unknowns to the rows of the prolongator built earlier (both particle lists are
-// sorted); returns how many unknowns entered or left the set since the build.
-size_t map_two_level_rows(const ImplicitCache& cache, PreconditionerState& state) {
+}  // namespace
+
+void apply_block_inverse(std::span<const Sym3> inverse, const double* r, double* y, double w,
+                         bool accumulate, const ImplicitSettings& settings) {
+  for_rows(static_cast<uint32_t>(inverse.size()), settings, [&](uint32_t b, uint32_t e) {
+    for (uint32_t u = b; u < e; ++u) {
+      const Sym3& k = inverse[u];
+      const double r0 = r[3 * u], r1 = r[3 * u + 1], r2 = r[3 * u + 2];
+      const double z0 = w * (k[0] * r0 + k[1] * r1 + k[2] * r2);
+      const double z1 = w * (k[1] * r0 + k[3] * r1 + k[4] * r2);
+      const double z2 = w * (k[2] * r0 + k[4] * r1 + k[5] * r2);
+      if (accumulate)
+        y[3 * u] += z0, y[3 * u + 1] += z1, y[3 * u + 2] += z2;
+      else
+        y[3 * u] = z0, y[3 * u + 1] = z1, y[3 * u + 2] = z2;
+    }
+  });
+}
+
+uint32_t aggregate(const BlockPattern& pattern, std::vector<uint32_t>& aggregate_of,
+                   uint32_t leftover_size) {
+  const uint32_t n = pattern.rows();
+  aggregate_of.assign(n, kNotUnknown);
+  uint32_t count = 0;
+  for (uint32_t u = 0; u < n; ++u) {
+    bool free = true;
+    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1] && free; ++b)
+      free = aggregate_of[pattern.col[b]] == kNotUnknown;
+    if (!free) continue;
+    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b)
+      aggregate_of[pattern.col[b]] = count;
+    ++count;
+  }
+  if (leftover_size > 0) {  // leftovers group with their free neighbours, up to leftover_size
+    for (uint32_t u = 0; u < n; ++u) {
+      if (aggregate_of[u] != kNotUnknown) continue;
+      aggregate_of[u] = count;
+      uint32_t size = 1;
+      for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1] && size < leftover_size;
+           ++b)
+        if (aggregate_of[pattern.col[b]] == kNotUnknown)
+          aggregate_of[pattern.col[b]] = count, ++size;
+      ++count;
+    }
+    return count;
+  }
+  std::vector<uint32_t> joined(aggregate_of);
+  for (uint32_t u = 0; u < n; ++u) {
+    if (aggregate_of[u] != kNotUnknown) continue;
+    for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b)
+      if (aggregate_of[pattern.col[b]] != kNotUnknown) {
+        joined[u] = aggregate_of[pattern.col[b]];
+        break;
+      }
+  }
+  aggregate_of.swap(joined);
+  for (uint32_t u = 0; u < n; ++u)
+    if (aggregate_of[u] == kNotUnknown) aggregate_of[u] = count++;
+  return count;
+}
+
+void sum_row_by_aggregate(const BlockPattern& pattern, const Sym3* blocks,
+                          std::span<const uint32_t> aggregate_of, uint32_t u,
+                          std::vector<uint32_t>& slot, std::vector<uint32_t>& aggregates,
+                          std::vector<Sym3>& sums) {
+  const size_t first = aggregates.size();
+  for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b) {
+    const uint32_t agg = aggregate_of[pattern.col[b]];
+    if (agg == kNotUnknown) continue;
+    if (slot[agg] == kNotUnknown) {
+      slot[agg] = static_cast<uint32_t>(sums.size());
+      aggregates.push_back(agg);
+      sums.push_back({});
+    }
+    Sym3& s = sums[slot[agg]];
+    for (int a = 0; a < 6; ++a) s[a] += blocks[b][a];
+  }
+  for (size_t t = first; t < aggregates.size(); ++t) slot[aggregates[t]] = kNotUnknown;
+}
+
+size_t map_built_rows(const ImplicitCache& cache, PreconditionerState& state) {
   const std::vector<uint32_t>& now = cache.unknowns.particles;
   const std::vector<uint32_t>& built = state.built_particles;
   state.p_row_of_unknown.assign(now.size(), kNotUnknown);
@@ -263,8 +287,6 @@ size_t map_two_level_rows(const ImplicitCache& cache, PreconditionerState& state
   return (now.size() - matched) + (built.size() - matched);
 }
 
-}  // namespace
-
 void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks, const double* x,
                        double* y, double alpha, const ImplicitSettings& settings) {
   assert(blocks_match(pattern, blocks));
@@ -279,20 +301,7 @@ void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks
 
 void write_matrix_pattern(const BlockPattern& pattern,
                           Eigen::SparseMatrix<double, Eigen::RowMajor, int>& matrix) {
-  const uint32_t nu = pattern.rows();
-  const int rows = static_cast<int>(3 * nu);
-  matrix.resize(rows, rows);
-  matrix.resizeNonZeros(static_cast<Eigen::Index>(9) * pattern.row_begin[nu]);
-  int* outer = matrix.outerIndexPtr();
-  int* inner = matrix.innerIndexPtr();
-  int k = 0;
-  for (uint32_t u = 0; u < nu; ++u)
-    for (int a = 0; a < 3; ++a) {
-      outer[3 * u + a] = k;
-      for (uint32_t b = pattern.row_begin[u]; b < pattern.row_begin[u + 1]; ++b)
-        for (int d = 0; d < 3; ++d) inner[k++] = static_cast<int>(3 * pattern.col[b]) + d;
-    }
-  outer[rows] = k;
+  write_block_layout(pattern.row_begin, pattern.col, matrix);
 }
 
 void write_matrix_values(const BlockPattern& pattern, std::span<const Sym3> blocks,
@@ -346,12 +355,15 @@ void update_preconditioner(ImplicitCache& cache) {
     // Rebuilt after a topology change or when the set moved on by more than the fraction.
     state.residual.resize(3 * Eigen::Index(nu));
     const bool same_topology = !kind_changed && state.built_for_topology == cache.topology_changes;
-    const size_t moved = same_topology ? map_two_level_rows(cache, state) : ~size_t(0);
+    const size_t moved = same_topology ? map_built_rows(cache, state) : ~size_t(0);
     if (same_topology && double(moved) <= cache.settings.two_level_rebuild_fraction * double(nu))
       return;
     build_two_level(cache, state);
-    map_two_level_rows(cache, state);
+    map_built_rows(cache, state);
     ++cache.stats.preconditioner_builds;
+  } else if (kind == Preconditioner::Deflation || kind == Preconditioner::Balancing) {
+    if (kind_changed) state.built_for_topology = ~uint64_t(0);
+    update_deflation(cache);
   }
 }
 
@@ -385,7 +397,10 @@ void solve_linear_system(ImplicitCache& cache, PhasedTeam* team) {
       PhasedTeam own(cache.pattern.rows() >= cache.settings.cg_team_min_rows);
       solve_row_chunked(cache, own);
     }
-  } else if (cache.settings.cg_operator == CgOperator::Assembled)
+    return;
+  }
+  if (cache.settings.preconditioner == Preconditioner::Deflation) deflate_guess(cache);
+  if (cache.settings.cg_operator == CgOperator::Assembled)
     solve_with(cache.system.matrix, cache);
   else
     solve_with(BlockOperator(cache), cache);
@@ -407,6 +422,10 @@ void apply_preconditioner(const ImplicitCache& cache, const double* r, double* z
           state.incomplete_cholesky.solve(Eigen::Map<const Eigen::VectorXd>(r, size));
       return;
     }
+    case Preconditioner::Deflation:
+    case Preconditioner::Balancing:
+      apply_deflation(cache, r, z);
+      return;
     case Preconditioner::TwoLevel: {
       // Symmetric two-level cycle: z = S·r; z += P·A_c⁻¹·Pᵀ·(r − A·z); z += S·(r − A·z), S = ω·D⁻¹.
       const std::span<const Sym3> blocks(cache.system.block);

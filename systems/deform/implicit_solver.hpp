@@ -25,6 +25,10 @@
 //                       damped block-Jacobi step, Galerkin coarse operator Pᵀ·A·P factorised by
 //                       sparse Cholesky; applied as a symmetric cycle (block-Jacobi pre-smooth,
 //                       coarse correction, the same post-smooth), so it is SPD and CG stays valid.
+//   Deflation           and Balancing: the same kind of two-level method on
+//                       unsmoothed aggregates, built to cost little per iteration on the small
+//                       active sets (implicit_deflation.cpp): one coarse solve and one pass over
+//                       A·P₀ per iteration instead of TwoLevel's three operator products.
 // IncompleteCholesky is rebuilt whenever the pattern is (unknown set or topology changed) and
 // otherwise reused stale. The active set changes in almost every frame of a capsulorhexis
 // (measured: 1010 pattern builds in 1040 frames at level 3), so TwoLevel keys its prolongator by
@@ -78,8 +82,27 @@ struct PreconditionerState {
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> coarse;
   double smoother_weight = 0.0;
   uint32_t aggregates = 0;
+  // Deflation and Balancing (implicit_deflation.cpp): unsmoothed aggregates P₀ keyed by particle
+  // (with built_particles, p_row_of_unknown and built_for_topology above), A·P₀ by rows and the
+  // coarse operator E = P₀ᵀ·A·P₀, both refreshed every step; E's block pattern is fixed at the
+  // build, `coarse` holds its factor.
+  std::vector<uint32_t> aggregate_of_built;      // per built unknown
+  std::vector<uint32_t> aggregate_of_unknown;    // per current unknown, or kNotUnknown
+  std::vector<uint32_t> ap_begin, ap_aggregate;  // per current unknown + 1 / per block: A·P₀ rows
+  std::vector<Sym3> ap_block;                    // Σ_{w∈J} A_uw (symmetric: A's blocks are)
+  std::vector<uint32_t> ap_slot;                 // scratch: per aggregate, its block in the row
+  std::vector<uint32_t> e_begin, e_row;  // per aggregate J + 1 / per block: E's rows I ≤ J, sorted
+  std::vector<uint32_t> members;         // per aggregate: today's unknowns in it
+  bool coarse_valid = false;             // E factorised (else the smoother alone)
+  // E, column-major: the blocks at and above the diagonal, aggregates in AMD's order; its factor;
+  // 1 / the diagonal of the factor L.
+  Eigen::SparseMatrix<double> coarse_matrix;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>>
+      deflation_factor;
+  Eigen::VectorXd coarse_inverse_diagonal;
+  std::vector<int> coarse_group_begin;  // columns of L solved together (implicit_deflation.cpp)
   // Scratch of one application (the preconditioner's solve is const in Eigen's interface).
-  mutable Eigen::VectorXd residual, coarse_rhs, coarse_solution;
+  mutable Eigen::VectorXd residual, coarse_rhs, coarse_solution, coarse_work;
 };
 
 namespace implicit_detail {
@@ -104,6 +127,27 @@ inline void block_row_product(const BlockPattern& pattern, const Sym3* blocks, c
 void add_block_product(const BlockPattern& pattern, std::span<const Sym3> blocks, const double* x,
                        double* y, double alpha, const ImplicitSettings& settings);
 
+// Writes a block-CSR layout of 3×3 blocks (per block row + 1: first block; per block: its
+// column) into a compressed sparse matrix, outer index by outer index: outer 3u + a holds,
+// for each block of u in order, the three inner indices 3·col + 0..2. Values are left as they are.
+template <class Matrix>
+void write_block_layout(std::span<const uint32_t> begin, std::span<const uint32_t> col,
+                        Matrix& matrix) {
+  const uint32_t n = static_cast<uint32_t>(begin.size() - 1);
+  matrix.resize(3 * Eigen::Index(n), 3 * Eigen::Index(n));
+  matrix.resizeNonZeros(9 * Eigen::Index(begin[n]));
+  int* outer = matrix.outerIndexPtr();
+  int* inner = matrix.innerIndexPtr();
+  int k = 0;
+  for (uint32_t u = 0; u < n; ++u)
+    for (int a = 0; a < 3; ++a) {
+      outer[3 * u + a] = k;
+      for (uint32_t b = begin[u]; b < begin[u + 1]; ++b)
+        for (int d = 0; d < 3; ++d) inner[k++] = static_cast<int>(3 * col[b]) + d;
+    }
+  outer[3 * n] = k;
+}
+
 // Writes the pattern's scalar layout into `matrix` (once per pattern) / its values (every use).
 // Unknown u owns rows 3u..3u+2; scalar row 3u+a holds 3·deg(u) entries, block by block.
 void write_matrix_pattern(const BlockPattern& pattern,
@@ -126,6 +170,38 @@ void solve_linear_system(ImplicitCache& cache, PhasedTeam* team = nullptr);
 
 // z = B⁻¹·r, B the cache's preconditioner.
 void apply_preconditioner(const ImplicitCache& cache, const double* r, double* z);
+
+// y_u = w·D_u⁻¹·r_u per unknown (block inverse), or y_u += w·D_u⁻¹·r_u.
+void apply_block_inverse(std::span<const Sym3> inverse, const double* r, double* y, double w,
+                         bool accumulate, const ImplicitSettings& settings);
+
+// Aggregates of the block graph, aggregate_of per unknown; returns their count. Deterministic
+// (nodes in index order). Vaněk, Mandel & Brezina 1996: a node whose neighbours are all free seeds
+// an aggregate of itself and them; then, with leftover_size 0, leftovers join a neighbouring
+// aggregate and what is still left forms its own (TwoLevel); otherwise each leftover forms an
+// aggregate with its free neighbours, at most leftover_size nodes (Deflation, Balancing: smaller
+// aggregates, a better unsmoothed coarse space).
+uint32_t aggregate(const BlockPattern& pattern, std::vector<uint32_t>& aggregate_of,
+                   uint32_t leftover_size = 0);
+
+// Row u of A·P₀, P₀ the aggregates' constants (aggregate_of per unknown, kNotUnknown: in none):
+// appends, per aggregate J of u's neighbours in first-seen order, J to `aggregates` and
+// Σ_{w∈J} A_uw to `sums`. `slot` (per aggregate, all kNotUnknown) is left as it was found.
+void sum_row_by_aggregate(const BlockPattern& pattern, const Sym3* blocks,
+                          std::span<const uint32_t> aggregate_of, uint32_t u,
+                          std::vector<uint32_t>& slot, std::vector<uint32_t>& aggregates,
+                          std::vector<Sym3>& sums);
+
+// Maps today's unknowns to the rows of the hierarchy built earlier (state.built_particles) into
+// state.p_row_of_unknown; returns how many unknowns entered or left the set since the build.
+size_t map_built_rows(const ImplicitCache& cache, PreconditionerState& state);
+
+// Deflation and Balancing (implicit_deflation.cpp): rebuild the aggregates when the set moved on
+// or the topology changed, refresh A·P₀ and E = P₀ᵀ·A·P₀ and refactor E (every step); apply.
+void update_deflation(ImplicitCache& cache);
+void apply_deflation(const ImplicitCache& cache, const double* r, double* z);
+// Deflation's CG must start with P₀ᵀ·r₀ = 0: x₀ += P₀·E⁻¹·P₀ᵀ·(b − A·x₀) (system.guess).
+void deflate_guess(ImplicitCache& cache);
 
 // An even number of chunks of about target_rows rows each (at least one): a PhasedTeam's two
 // threads start from opposite ends and meet in the middle with equal shares.

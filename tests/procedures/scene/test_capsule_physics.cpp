@@ -55,7 +55,8 @@ Outcome run(const std::string& preconditioner, int threads) {
 }
 
 TEST(CapsulePhysics, EveryPreconditionerGivesTheSameStateHashOnOneAndTwoThreads) {
-  for (const std::string p : {"jacobi", "block_jacobi", "incomplete_cholesky", "two_level"}) {
+  for (const std::string p :
+       {"jacobi", "block_jacobi", "incomplete_cholesky", "two_level", "deflation", "balancing"}) {
     SCOPED_TRACE(p);
     const Outcome one = run(p, 1), two = run(p, 2);
     EXPECT_EQ(one.hash, two.hash);

@@ -6,6 +6,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,8 +23,9 @@ using deform::Preconditioner;
 using implicit_test::Body;
 
 constexpr double kFrameStep = 1.0 / 120.0;
-constexpr Preconditioner kAll[] = {Preconditioner::Jacobi, Preconditioner::BlockJacobi,
-                                   Preconditioner::IncompleteCholesky, Preconditioner::TwoLevel};
+constexpr Preconditioner kAll[] = {
+    Preconditioner::Jacobi,   Preconditioner::BlockJacobi, Preconditioner::IncompleteCholesky,
+    Preconditioner::TwoLevel, Preconditioner::Deflation,   Preconditioner::Balancing};
 
 // The capsule's sheet (E·h = 26 mN/mm) pre-stretched 2 %, pinned at the rim, under gravity: in
 // plane the springs' full stiffness, out of plane only the tension (≈ 50× softer), and the mass
@@ -97,8 +99,9 @@ TEST(ImplicitSolver, StrongerPreconditionersNeedFewerIterationsThanJacobi) {
     b.dynamics.gravity_mm_s2 = {0.0f, 0.0f, -9810.0f};
     ImplicitCache cache = assembled(b);
     const int jacobi = solve_from_zero(cache, Preconditioner::Jacobi).iterations;
-    for (Preconditioner p : {Preconditioner::BlockJacobi, Preconditioner::IncompleteCholesky,
-                             Preconditioner::TwoLevel}) {
+    for (Preconditioner p :
+         {Preconditioner::BlockJacobi, Preconditioner::IncompleteCholesky, Preconditioner::TwoLevel,
+          Preconditioner::Deflation, Preconditioner::Balancing}) {
       const Solved s = solve_from_zero(cache, p);
       std::printf("[ figures  ] capsule level %d, %u unknowns: %s %d iterations, jacobi %d\n",
                   level, cache.stats.unknowns, std::string(deform::to_string(p)).c_str(),
@@ -111,7 +114,9 @@ TEST(ImplicitSolver, StrongerPreconditionersNeedFewerIterationsThanJacobi) {
 
 // Steps on an unchanged set reuse the factorisations (stale); a cut or a tear rebuilds them.
 TEST(ImplicitSolver, FactorisationsAreRebuiltOnlyWithThePatternOrTopology) {
-  for (Preconditioner p : {Preconditioner::IncompleteCholesky, Preconditioner::TwoLevel}) {
+  for (Preconditioner p : {Preconditioner::IncompleteCholesky, Preconditioner::TwoLevel,
+                           Preconditioner::Deflation, Preconditioner::Balancing}) {
+    SCOPED_TRACE(std::string(deform::to_string(p)));
     Body b = stiff_membrane(15);
     ImplicitCache cache;
     cache.settings.preconditioner = p;
@@ -153,6 +158,71 @@ TEST(ImplicitSolver, TwoLevelOutlivesSmallChangesOfTheSet) {
   step();
   EXPECT_EQ(cache.stats.pattern_builds, 3u);
   EXPECT_EQ(cache.stats.preconditioner_builds, 2u);
+}
+
+// Deflation starts CG where P₀ᵀ·r₀ = 0; from there its iterates are Balancing's (the symmetric
+// coarse–smoother–coarse preconditioner), at about half the cost per iteration.
+TEST(ImplicitSolver, DeflationStartsDeflatedAndFollowsBalancing) {
+  Body b = implicit_test::make_capsule(1, 2000.0, 0.02);
+  b.dynamics.gravity_mm_s2 = {0.0f, 0.0f, -9810.0f};
+  ImplicitCache cache = assembled(b);
+  const Solved balancing = solve_from_zero(cache, Preconditioner::Balancing);
+  const Solved deflation = solve_from_zero(cache, Preconditioner::Deflation);
+  std::printf("[ figures  ] capsule level 1: balancing %d iterations, deflation %d\n",
+              balancing.iterations, deflation.iterations);
+  ASSERT_TRUE(balancing.converged);
+  ASSERT_TRUE(deflation.converged);
+  EXPECT_LE(std::abs(deflation.iterations - balancing.iterations), 2);
+  EXPECT_LT((deflation.dv - balancing.dv).norm(), 1e-4 * balancing.dv.norm());
+
+  // The deflated first guess: every aggregate's residual sums to zero.
+  const deform::PreconditionerState& state = *cache.preconditioner;
+  cache.system.guess.setZero(cache.system.rhs.size());
+  deform::implicit_detail::deflate_guess(cache);
+  Eigen::VectorXd r = cache.system.rhs;
+  deform::implicit_detail::add_block_product(
+      cache.pattern, cache.system.block, cache.system.guess.data(), r.data(), -1.0, cache.settings);
+  Eigen::VectorXd per_aggregate = Eigen::VectorXd::Zero(3 * state.aggregates);
+  for (uint32_t u = 0; u < cache.pattern.rows(); ++u)
+    for (int a = 0; a < 3; ++a)
+      per_aggregate[3 * state.aggregate_of_unknown[u] + a] += r[3 * u + a];
+  EXPECT_GT(state.aggregates, 10u);
+  EXPECT_LT(per_aggregate.norm(), 1e-9 * cache.system.rhs.norm());
+}
+
+// A grasp takes a whole patch out of the set: its aggregates empty, the hierarchy is kept (the
+// patch is below the rebuild fraction), and the coarse operator stays exact on what is left, so
+// both still solve to the tolerance and agree with a direct solve.
+TEST(ImplicitSolver, DeflationKeepsItsAggregatesWhenAPatchLeavesTheSet) {
+  const int n = 15;
+  for (Preconditioner p : {Preconditioner::Deflation, Preconditioner::Balancing}) {
+    SCOPED_TRACE(std::string(deform::to_string(p)));
+    Body b = stiff_membrane(n);
+    ImplicitCache cache;
+    cache.settings.preconditioner = p;
+    auto step = [&] {
+      auto m = b.membrane();
+      deform::implicit_euler_step(m, kFrameStep, cache);
+      EXPECT_TRUE(cache.stats.cg_converged);
+    };
+    step();
+    for (int y = 5; y < 10; ++y)
+      for (int x = 5; x < 10; ++x) b.particles.kind[y * n + x] = ParticleKind::Scripted;
+    step();
+    EXPECT_EQ(cache.stats.pattern_builds, 2u);
+    EXPECT_EQ(cache.stats.preconditioner_builds, 1u) << "25 of 169 unknowns: below the fraction";
+    const deform::PreconditionerState& state = *cache.preconditioner;
+    EXPECT_NE(std::count(state.members.begin(), state.members.end(), 0u), 0)
+        << "an emptied aggregate";
+    const Eigen::SparseMatrix<double> a = assembled_matrix(cache);
+    const Eigen::VectorXd exact =
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(a).solve(cache.system.rhs);
+    const Solved s = solve_from_zero(cache, p);
+    ASSERT_TRUE(s.converged);
+    EXPECT_EQ(cache.stats.preconditioner_builds, 1u);
+    EXPECT_LE((a * s.dv - cache.system.rhs).norm(), 1.5e-6 * cache.system.rhs.norm());
+    EXPECT_LT((s.dv - exact).norm(), 1e-3 * exact.norm());
+  }
 }
 
 // Threaded settings: every row loop splits into chunks of 16 rows, and the step forms its team
