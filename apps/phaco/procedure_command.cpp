@@ -18,12 +18,13 @@ namespace {
 // --record/--trainee (docs/records.md, docs/procedures.md): each step that ran is stored as its
 // drill's record (the schema has no procedure table, and needs none): its recording is the step's
 // scenario, its report the step's, with "procedure" saying which procedure, which step and the
-// total. A stored step replays as a drill on a fresh eye; the procedure's replay is its file.
+// total, dated when that step ran (so the records keep the steps' order). A stored step replays
+// as a drill on a fresh eye; the procedure's replay is its file.
 void record_steps(const std::filesystem::path& db, const std::string& trainee,
                   const Procedure& procedure, const ProcedureReport& report, nlohmann::json& j) {
   for (size_t i = 0; i < report.steps.size(); ++i) {
     nlohmann::json step = j["steps"][i];
-    step["date"] = j["date"];
+    const ProcedureStepReport& ran = report.steps[i];
     step["procedure"] = {{"name", report.name},
                          {"file", report.source},
                          {"step", i + 1},
@@ -31,7 +32,8 @@ void record_steps(const std::filesystem::path& db, const std::string& trainee,
                          {"total", report.total},
                          {"failed", report.failed},
                          {"failure", report.failure}};
-    const int64_t id = record_run(db, trainee, procedure.steps[i], step);
+    const int64_t id = record_run(db, trainee, procedure.steps[i], step,
+                                  ran.finished_unix_s - ran.started_unix_s, ran.finished_unix_s);
     j["steps"][i]["record_id"] = id;
     std::fprintf(stderr, "step %zu %s recorded as record %lld in %s\n", i + 1,
                  std::string(to_string(procedure.steps[i].drill)).c_str(),

@@ -22,10 +22,14 @@ std::string format_utc(double unix_seconds) {
   return buf;
 }
 
-std::string utc_now() {
+double unix_now_s() {
   timespec ts{};
   clock_gettime(CLOCK_REALTIME, &ts);
-  return format_utc(static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+std::string utc_now() {
+  return format_utc(unix_now_s());
 }
 
 std::optional<double> parse_utc(const std::string& text) {

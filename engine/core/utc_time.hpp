@@ -10,6 +10,8 @@ namespace phaco {
 std::string format_utc(double unix_seconds);
 // Now.
 std::string utc_now();
+// Seconds since the Unix epoch now (the realtime clock).
+double unix_now_s();
 // The inverse of format_utc: seconds since the Unix epoch, or nullopt when `text` is not in the
 // format (exactly "YYYY-MM-DDTHH:MM:SS.mmmZ", fields in range).
 std::optional<double> parse_utc(const std::string& text);

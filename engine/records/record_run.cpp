@@ -1,7 +1,5 @@
 #include "engine/records/record_run.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -64,12 +62,6 @@ void check_record_target(const fs::path& db, const std::string& trainee) {
   check_trainee(trainee);
   make_parent_dir(db);
   const RecordStore store(db, OpenMode::CreateIfMissing);
-}
-
-double unix_now_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
 }
 
 int64_t record_run(const fs::path& db, const std::string& trainee, const Scenario& scenario,

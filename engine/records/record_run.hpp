@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "engine/core/utc_time.hpp"  // unix_now_s(): the clock record_run reads
 #include "engine/io/scenario.hpp"
 
 namespace phaco {
@@ -37,8 +38,5 @@ int64_t record_run(const std::filesystem::path& db, const std::string& trainee,
                    const Scenario& scenario, const nlohmann::json& report,
                    std::optional<double> run_s = std::nullopt,
                    std::optional<double> finished_unix_s = std::nullopt);
-
-// Seconds since the Unix epoch now (the realtime clock), as record_run reads it.
-double unix_now_s();
 
 }  // namespace phaco

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "engine/core/clock.hpp"
+#include "engine/core/utc_time.hpp"
 #include "engine/core/version.hpp"
 #include "procedures/procedure/carry.hpp"
 
@@ -50,12 +51,18 @@ bool procedure_done(const ProcedureState& s) {
 }
 
 std::unique_ptr<Scene> start_step(ProcedureState& s, SceneOptions options) {
+  s.step_started_unix_s = unix_now_s();
   options.carried = &s.carried;
   return build_scene(s.procedure->steps.at(s.next), options);
 }
 
 void finish_step(ProcedureState& s, Scene& scene, double wall_time_s) {
   ProcedureStepReport step;
+  step.finished_unix_s = unix_now_s();
+  // A scene not built by start_step (the trainer's session builds its own) ran for its wall time.
+  step.started_unix_s =
+      s.step_started_unix_s > 0 ? s.step_started_unix_s : step.finished_unix_s - wall_time_s;
+  s.step_started_unix_s = 0;
   step.carried_in = carried_json(s.carried);
   step.run = report_of(scene);
   step.run.wall_time_s = wall_time_s;
@@ -88,6 +95,7 @@ nlohmann::json to_json(const ProcedureReport& r) {
   for (const auto& step : r.steps) {
     nlohmann::json j = to_json(step.run);
     j["carried_in"] = step.carried_in;
+    if (step.finished_unix_s > 0) j["date"] = format_utc(step.finished_unix_s);  // as a drill's
     steps.push_back(std::move(j));
   }
   nlohmann::json scores = nlohmann::json::object();

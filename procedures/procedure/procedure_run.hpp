@@ -23,6 +23,9 @@ namespace phaco {
 struct ProcedureStepReport {
   RunReport run;                                         // as its drill scores it
   nlohmann::json carried_in = nlohmann::json::object();  // the eye it started from
+  // When the step ran, wall clock (s since the Unix epoch): its scene built, its score taken. Each
+  // step's record is dated by these, so the records keep the steps' order.
+  double started_unix_s = 0, finished_unix_s = 0;
 };
 
 struct ProcedureReport {
@@ -40,6 +43,7 @@ struct ProcedureState {
   size_t next = 0;  // the step start_step builds
   CarriedState carried;
   ProcedureReport report;
+  double step_started_unix_s = 0;  // when start_step began building the next step's scene
 };
 
 ProcedureState begin_procedure(const Procedure& procedure);

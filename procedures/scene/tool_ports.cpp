@@ -145,8 +145,11 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
           h.tip_mm = pose.pos;
           h.shaft = pose.quat.normalized() * Vec3::UnitZ();
           const ToolKind kind = scene.world.at<Tool>(scene.tools[i]).kind;
-          // The phaco probe's work is inside the nucleus: the lens is no boundary for it.
-          h.lens_spring = kind != ToolKind::PhacoProbe;
+          // The phaco probe's and the chopper's work is inside the nucleus (its trenches and
+          // cracks): the lens is no boundary for them. With the spring, the chopper down in the
+          // trench (2.8 mm inside the uncut lens's surface) pressed the side port 147 mN and
+          // turned the globe 9°, which pushed the main port onto the probe's shaft as well.
+          h.lens_spring = kind != ToolKind::PhacoProbe && kind != ToolKind::Chopper;
           // The keratome cuts its tunnel (cornea_cutting), it does not pass through one: the
           // ports model finished incisions, and a blade pressed through the slit "across" would
           // be read as a tunnel pushed on (82 mN for the incision expert) when it is the cut.

@@ -8,7 +8,9 @@ The drill starts with the nucleus grooved by a cross (data/drills/nucleus_remova
 guidance.trench_cross: one trench along x, one along y, 1.35 mm wide, 80 % deep). The expert:
   1. both tips into the x trench at x = -1.2, on its walls, pushed apart across it: the nucleus
      cracks into two halves along y = 0;
-  2. the same in the y trench at y = +1.2 and at y = -1.2: four quadrants;
+  2. the same in the y trench of the -y half (y = -1.2), then of the +y half (y = +1.2, higher),
+     pushed apart at ten places across the trench, since the halves move once apart (crack()):
+     four quadrants;
   3. for each quadrant: the probe into its inner corner with aspiration (pedal 2) until the port
      occludes and the vacuum holds the quadrant, then ultrasound (pedal 3) while the vacuum feeds it
      into the tip; lift.
@@ -25,7 +27,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("out")
 ap.add_argument("--dip", action="store_true")
 ap.add_argument("--wasteful", action="store_true")
-ap.add_argument("--quadrant-s", type=float, default=10.0)
+ap.add_argument("--quadrant-s", type=float, default=11.0)
 ap.add_argument("--cleanup-s", type=float, default=6.0)
 ap.add_argument("--level", type=int, default=1)
 ap.add_argument("--name", default="nucleus removal expert")
@@ -59,23 +61,30 @@ park_p = inward(main, 3.0, Z_ABOVE)
 park_c = inward(side, 3.0, Z_ABOVE)
 both(1.0, park_p, 1, park_c)
 
-def crack(p_at, c_at, spread):
-    """Both tips down onto opposite walls of a trench, pushed apart by `spread` each, lifted."""
-    above_p, above_c = p_at[:2] + [Z_ABOVE], c_at[:2] + [Z_ABOVE]
-    both(0.8, above_p, 1, above_c)
-    both(0.6, p_at[:2] + [Z_CRACK], 1, c_at[:2] + [Z_CRACK])
-    d = [p_at[i] - c_at[i] for i in range(2)]
-    n = math.hypot(*d); d = [v / n for v in d]
-    pa = [p_at[0] + spread * d[0], p_at[1] + spread * d[1], Z_CRACK]
-    ca = [c_at[0] - spread * d[0], c_at[1] - spread * d[1], Z_CRACK]
-    both(0.6, pa, 1, ca)
-    both(0.3, pa, 1, ca)
-    both(0.6, pa[:2] + [Z_ABOVE], 1, ca[:2] + [Z_ABOVE])
+def crack(mid, d, offsets, sep=(1.0, 1.6), z=None):
+    """The probe and the chopper down in a trench about `mid` (x, y), on either side along `d`
+    (the unit push, chopper -> probe), then, at each of `offsets` (mm along `d` from `mid`, in
+    turn), pushed apart from sep[0] to sep[1] and brought back together as they move on; lifted.
+    Why several places: a half that moved after the first crack carries its trench along (0.15-0.5
+    mm at 1.2 mm from the centre, the carried trench of a procedure more than the drill's groove,
+    and the pieces settle differently run to run), and blind tips cannot see where it went. The
+    push cracks where it engages (lens_tools/crack: both tips on the fragment, no cell at their
+    midpoint, then 0.2 mm more spread); bringing the tips together re-arms it for the next place."""
+    def at(c, h): return [mid[0] + (c + h) * d[0], mid[1] + (c + h) * d[1]]
+    zc = Z_CRACK if z is None else z
+    o = offsets[0]
+    both(0.8, at(o, 0.5 * sep[0]) + [Z_ABOVE], 1, at(o, -0.5 * sep[0]) + [Z_ABOVE])
+    both(0.6, at(o, 0.5 * sep[0]) + [zc], 1, at(o, -0.5 * sep[0]) + [zc])
+    for k, o in enumerate(offsets):
+        if k:
+            both(0.15, at(o, 0.5 * sep[0]) + [zc], 1, at(o, -0.5 * sep[0]) + [zc])
+        both(0.3, at(o, 0.5 * sep[1]) + [zc], 1, at(o, -0.5 * sep[1]) + [zc])
+    both(0.6, at(o, 0.5 * sep[1]) + [Z_ABOVE], 1, at(o, -0.5 * sep[1]) + [Z_ABOVE])
 
-# The walls of a 1.35 mm trench are at +-0.675: the tips start 0.4 off its middle.
-crack([-1.2, -0.4], [-1.2, 0.4], 0.2)   # along the x trench: two halves
-crack([0.4, 1.2], [-0.4, 1.2], 0.2)     # the +y half along the y trench
-crack([0.4, -1.2], [-0.4, -1.2], 0.2)   # the -y half
+ACROSS = [-0.8, -0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0]
+crack([-1.2, 0.0], [0.0, -1.0], [0.0], sep=(0.8, 1.4))  # along the x trench: two halves
+crack([0.0, -1.2], [1.0, 0.0], ACROSS)   # the -y half along the y trench
+crack([0.0, 1.2], [1.0, 0.0], ACROSS, z=0.1)  # the +y half, higher: its pieces sank
 
 chopper_park = [-1.0, 0.0, Z_ABOVE]
 occlude_pedal = 3 if args.wasteful else 2

@@ -73,7 +73,7 @@ struct HandPose {
   Vec3 tip_mm = Vec3::Zero();
   Vec3 shaft = Vec3::UnitZ();  // tip → handle
   int port = -1;               // engaged_port's answer; −1: free
-  bool lens_spring = true;     // false for a tool whose work is inside the lens (the phaco probe)
+  bool lens_spring = true;     // false for a tool whose work is inside the lens (probe, chopper)
 };
 
 struct SolverOptions {

@@ -112,6 +112,21 @@ TEST(ProcedureCli, EachStepIsStoredAsItsDrillsRecord) {
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(read_text(dir / "again.json"))["state_hash"],
             run["steps"][0]["state_hash"]);
+
+  // Each step's record is dated when that step ran: it ended before the next began, and the last
+  // ended by the time the run did (they were dated when stored, after the whole procedure, back
+  // by each step's own wall time, so a long last step seemed to start before the others). The
+  // dates sort as text.
+  const std::string id2 = std::to_string(h["records"][1]["id"].get<int64_t>());
+  r = phaco("export " + id2 + " --db " + db.string() + " --json " + (dir / "e2.json").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json e2 = nlohmann::json::parse(read_text(dir / "e2.json"));
+  const std::string end1 = e["finished_utc"], start2 = e2["started_utc"], end2 = e2["finished_utc"];
+  EXPECT_LE(e["started_utc"].get<std::string>(), end1);
+  EXPECT_LE(end1, start2);
+  EXPECT_LE(start2, end2);
+  EXPECT_LE(end2, run["date"].get<std::string>()) << "the last step's record ends after the run";
+  EXPECT_EQ(end2, run["steps"][1]["date"]);
 }
 
 }  // namespace

@@ -98,9 +98,10 @@ TEST(Procedure, TheExpertRunsEndToEndAndEachStepScoresAsItsDrillOnTheCarriedEye)
   EXPECT_LT(worst_off_port, 1e-6) << "mm from the carried port's centre";
   // So the later experts' tools do not press on the cut tunnel: made for the drill's default
   // port they pressed it 93-112 mN and turned the globe 4.6-5.3° (capsulorhexis, sculpting);
-  // alone, in their own port, ~1 mN. (The nucleus removal's chopper presses its side port, which
-  // is not carried, in the procedure as alone: the globe it turns moves the main port too.)
-  for (size_t i = 1; i < 3; ++i) {
+  // alone, in their own port, ~1 mN. Nor the nucleus removal's chopper on its side port: down in
+  // the trench it met the uncut lens's spring and pressed the port 146 mN, turning the globe 8.5°
+  // (tool_ports: the lens is no boundary for the probe and the chopper).
+  for (size_t i = 1; i < 4; ++i) {
     EXPECT_LT(main_port_force[i], 10.0) << i;
     EXPECT_LT(r.steps[i].run.metrics.value("ports.max_force_mN", 1e9), 10.0) << i;
     EXPECT_LT(r.steps[i].run.metrics.value("globe.max_rotation_deg", 1e9), 1.0) << i;
