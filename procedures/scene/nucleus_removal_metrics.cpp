@@ -45,6 +45,9 @@ NucleusRemovalRecord make_nucleus_removal_record(const Scene& scene) {
         std::sqrt(std::max(0.0, b.radius_mm * b.radius_mm - (r.rim_z_mm - c2) * (r.rim_z_mm - c2)));
   }
   r.through.assign(scene.tools.size(), 0);
+  r.entry.assign(scene.tools.size(), Vec3::Zero());
+  r.entered.assign(scene.tools.size(), 0);
+  r.wound_radius_mm = scene.params.get("tools.keratome_width_mm");
   return r;
 }
 
@@ -62,7 +65,9 @@ uint32_t sample_nucleus_removal(Scene& scene, NucleusRemovalRecord& r, double dt
     r.through[i] = through;
     const auto& cornea = r.bounds.cornea;
     const double de = cornea.radius_mm - (p - cornea.centre).norm();
-    if (std::hypot(p.x(), p.y()) < r.pupil_radius_mm && de > 0) {
+    if (!r.entered[i] && de > 0) r.entered[i] = 1, r.entry[i] = p;
+    const bool in_wound = r.entered[i] && (p - r.entry[i]).norm() <= r.wound_radius_mm;
+    if (std::hypot(p.x(), p.y()) < r.pupil_radius_mm && de > 0 && !in_wound) {
       r.endothelium_min_distance_mm = std::min(r.endothelium_min_distance_mm, de);
       near |= de < kEndotheliumNearMm;
     }

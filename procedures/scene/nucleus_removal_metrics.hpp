@@ -41,7 +41,13 @@ struct NucleusRemovalRecord {
   double endothelium_near_s = 0;  // time with a tip closer than kEndotheliumNearMm
   uint32_t anterior_chamber_max = 0;
   bool ruptured = false;
-  std::vector<uint8_t> through;    // per tool: its tip is through the posterior capsule
+  std::vector<uint8_t> through;  // per tool: its tip is through the posterior capsule
+  // Per tool: where its tip first came behind the cornea's posterior surface (the wound's inner
+  // opening, drill_events' rule); within wound_radius_mm of it the tip is in the incision, not at
+  // the endothelium. A carried main port may open over the pupil.
+  std::vector<Vec3> entry;
+  std::vector<uint8_t> entered;
+  double wound_radius_mm = 0;
   std::vector<double> fx, fy, fz;  // per fragment: mass-weighted centre (scratch)
 };
 
