@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/trainer/trainer_files.hpp"
 #include "apps/trainer/trainer_procedure.hpp"
 #include "apps/trainer/trainer_settings.hpp"
 #include "apps/trainer/trainer_soak.hpp"
@@ -144,18 +145,6 @@ void load_font() {
   config.PixelSnapH = true;
   if (std::filesystem::exists(path))
     ImGui::GetIO().Fonts->AddFontFromFileTTF(path, 14.0f, &config, kRanges);
-}
-
-void write_json_file(const std::filesystem::path& file, const nlohmann::json& j,
-                     const char* what = "the UI state") {
-  // Whole or not at all: a reader never sees half a file.
-  const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << "\n";
-    if (!out) throw InputError(tmp.string() + ": cannot write " + what);
-  }
-  std::filesystem::rename(tmp, file);
 }
 
 InputGlue* glue_of(GLFWwindow* w) {
@@ -331,43 +320,6 @@ void read_input(GLFWwindow* window, InputGlue& glue, const TrainerOptions& o,
     if (pressed_once(window, GLFW_KEY_F1, glue.f1_down)) ui.toggle_controls();
     if (pressed_once(window, GLFW_KEY_F12, glue.f12_down)) glue.save_view = true;
   }
-}
-
-// The view alone (no panels), drawn off-screen at w × h and saved as a PNG: a hidden or covered
-// window's pixels are undefined. Leaves the window's framebuffer bound.
-void save_view(render::Renderer& renderer, const render::RenderSnapshot& snap,
-               const render::Microscope& microscope, int w, int h,
-               const std::filesystem::path& file) {
-  render::OffscreenTarget target(w, h);
-  glViewport(0, 0, w, h);
-  glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  renderer.draw(snap, microscope, w, h);
-  render::save_screenshot(file, w, h);
-  render::OffscreenTarget::unbind();
-}
-
-// What F12's view shows, beside its PNG: the tools' shown poses, the globe's turn and the camera,
-// so the picture can be checked against the geometry (tests/apps/test_trainer_port_view.cpp).
-void write_view_poses(const std::filesystem::path& file, const render::RenderSnapshot& snap,
-                      const render::Microscope& m, double sim_time_s, int w, int h) {
-  const auto xyz = [](const Vec3& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
-  nlohmann::json j;
-  j["sim_time_s"] = sim_time_s;
-  j["width"] = w, j["height"] = h;
-  j["microscope"] = {{"field_mm", m.field_mm},
-                     {"focus_z_mm", m.focus_z_mm},
-                     {"working_distance_mm", m.working_distance_mm},
-                     {"centre_mm", xyz(m.centre_mm)}};
-  const Quat& g = snap.globe_rotation;
-  j["globe_rotation_wxyz"] = {g.w(), g.x(), g.y(), g.z()};
-  j["tools"] = nlohmann::json::array();
-  for (const render::ToolView& t : snap.tools)
-    j["tools"].push_back({{"hand", std::string(to_string(t.hand))},
-                          {"tool", std::string(to_string(t.kind))},
-                          {"tip_mm", xyz(t.tip_mm)},
-                          {"shaft", xyz(t.quat.normalized() * Vec3::UnitZ())}});
-  write_json_file(file, j, "the view's poses");
 }
 
 // Closing with drills the database refused: never lose them silently. Beside the database first;
