@@ -1,3 +1,5 @@
+// The window, its input and the frame loop in one file on purpose: they share one GLFW/ImGui
+// context and its callbacks' glue (InputGlue); what the trainer writes is in trainer_files.
 #include "apps/trainer/trainer_app.hpp"
 
 // GLFW must not pull in a GL header: libepoxy provides the GL declarations.
