@@ -100,7 +100,7 @@ studies:
       repetition gives a paired fps ratio, reported with its 95 % interval. A variant is this
       build reading another data folder (e.g. a drill with a body taken out; @DRILL: in that
       drill only), to tell a scene's content from the code. About 1 minute per run (default: 3 drills x 2 builds x 4 = 24 runs).
-  sweep [--max-level L] [--drill NAME]... [--replot]
+  sweep [--max-level L] [--drill NAME]... [--speedup-reps N] [--replot]
   sweep --reference [--drill NAME]... [--reference-level L] [--reference-dt-divisor K]
       Issues 9 and 17, the whole trainer under load: each drill's scripted expert run to its end
       at every resolution level 0..L (default 8: 256k capsule vertices, 1.6M lens tets; quick
@@ -116,7 +116,10 @@ studies:
       (Pareto fronts), haptic period, memory; judges the issues' targets. Checks (exit status 1 if
       any fails): every point runs to its end, 1 and 2 threads give the same state hash, the
       default methods never diverge and stay within their accuracy bounds against the run's own
-      finest level. About 18 minutes (quick about 1).
+      finest level. --speedup-reps N (default 5, quick 1): the capsulorhexis points on 1 and 2
+      threads run N times in all, the repeats last, so that the 2-thread speed-up is the mean of
+      N paired runs with its 95 % interval (repeats must give the same state hash). About 25
+      minutes (quick about 1).
       --replot redraws the section and charts from DIR/results/sweep_points.json without
       measuring again (the figures stay those of the run that measured them).
       --reference makes DIR/results/sweep_reference.json instead: per drill, one run off the

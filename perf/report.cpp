@@ -151,4 +151,26 @@ std::string fmt_or_dash(const char* format, double v) {
   return std::isfinite(v) ? fmt(format, v) : std::string("-");
 }
 
+namespace {
+
+// Two-sided 95 % Student's t for n − 1 degrees of freedom (n ≥ 2).
+double t95(size_t n) {
+  static const double t[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262};
+  return n - 1 <= 9 ? t[n - 2] : 1.96 + 2.4 / double(n - 1);  // beyond 10: within 1 % of the table
+}
+
+}  // namespace
+
+MeanInterval mean_interval95(const std::vector<double>& values) {
+  const size_t n = values.size();
+  if (n == 0) return {NAN, NAN, NAN};
+  MeanInterval r;
+  for (double x : values) r.mean += x / double(n);
+  double ss = 0;
+  for (double x : values) ss += (x - r.mean) * (x - r.mean);
+  const double half = n > 1 ? t95(n) * std::sqrt(ss / double(n - 1) / double(n)) : INFINITY;
+  r.lo = r.mean - half, r.hi = r.mean + half;
+  return r;
+}
+
 }  // namespace phaco::perf

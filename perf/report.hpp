@@ -56,4 +56,12 @@ std::string fmt(const char* format, double v);
 // The same, or "-" for a NaN or infinite value (a figure that was not measured).
 std::string fmt_or_dash(const char* format, double v);
 
+// The mean of repeated measurements and its two-sided 95 % interval (Student's t, n − 1 degrees of
+// freedom): how studies report a figure that differs from run to run on a shared machine. With one
+// value the interval is unbounded (±inf); with none, everything is NaN.
+struct MeanInterval {
+  double mean = 0, lo = 0, hi = 0;
+};
+MeanInterval mean_interval95(const std::vector<double>& values);
+
 }  // namespace phaco::perf

@@ -40,10 +40,13 @@ SweepRun new_run(const SweepArgs& args, const StudyOptions& options) {
   run.threads = {1, 2};
   if (const int hw = int(std::thread::hardware_concurrency()); hw > 2) run.threads.push_back(hw);
   run.variant_levels = options.quick ? std::vector<int>{1} : std::vector<int>{1, 3, 5};
-  run.command = std::string("phaco-perf sweep") + (options.quick ? " --quick" : "") +
-                (run.max_level != (options.quick ? 3 : eye::kMaxLevel)
-                     ? " --max-level " + std::to_string(run.max_level)
-                     : "");
+  run.speedup_reps = args.speedup_reps > 0 ? args.speedup_reps : options.quick ? 1 : 5;
+  run.command =
+      std::string("phaco-perf sweep") + (options.quick ? " --quick" : "") +
+      (run.max_level != (options.quick ? 3 : eye::kMaxLevel)
+           ? " --max-level " + std::to_string(run.max_level)
+           : "") +
+      (args.speedup_reps > 0 ? " --speedup-reps " + std::to_string(run.speedup_reps) : "");
   return run;
 }
 

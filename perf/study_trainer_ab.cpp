@@ -96,27 +96,6 @@ AbOptions parse(const StudyOptions& options) {
   return o;
 }
 
-// Two-sided 95 % Student's t for n − 1 degrees of freedom (n ≥ 2).
-double t95(int n) {
-  static const double t[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262};
-  return n - 1 <= 9 ? t[n - 2] : 1.96 + 2.4 / (n - 1);  // beyond 10: within 1 % of the table
-}
-
-struct Interval {
-  double mean = 0, lo = 0, hi = 0;
-};
-
-Interval mean_interval(const std::vector<double>& v) {
-  const int n = static_cast<int>(v.size());
-  Interval r;
-  for (double x : v) r.mean += x / n;
-  double ss = 0;
-  for (double x : v) ss += (x - r.mean) * (x - r.mean);
-  const double half = n > 1 ? t95(n) * std::sqrt(ss / (n - 1) / n) : INFINITY;
-  r.lo = r.mean - half, r.hi = r.mean + half;
-  return r;
-}
-
 }  // namespace
 
 void run_trainer_ab(const StudyOptions& options) {
@@ -192,15 +171,15 @@ void run_trainer_ab(const StudyOptions& options) {
   for (size_t b = 0; b < nb; ++b)
     chart.series.push_back({.name = o.builds[b].name, .style = Style::Scatter});
   auto range = [](const std::vector<double>& v, const char* f) {
-    return fmt(f, mean_interval(v).mean) + " [" + fmt(f, *std::min_element(v.begin(), v.end())) +
+    return fmt(f, mean_interval95(v).mean) + " [" + fmt(f, *std::min_element(v.begin(), v.end())) +
            " – " + fmt(f, *std::max_element(v.begin(), v.end())) + "]";
   };
   auto paired = [](const std::vector<double>& v, const std::vector<double>& base) {
     std::vector<double> r;
     for (size_t i = 0; i < v.size(); ++i) r.push_back(v[i] / base[i]);
-    return mean_interval(r);
+    return mean_interval95(r);
   };
-  auto text = [](const Interval& i) {
+  auto text = [](const MeanInterval& i) {
     return fmt("%.3f", i.mean) + " [" + fmt("%.3f", i.lo) + " – " + fmt("%.3f", i.hi) + "]";
   };
   for (size_t d = 0; d < o.drills.size(); ++d) {
@@ -214,7 +193,7 @@ void run_trainer_ab(const StudyOptions& options) {
       if (f.empty()) continue;
       std::string fps_ratio = "—", cpu_ratio = "—", verdict_text = "—";
       if (b > 0) {
-        const Interval fr = paired(f, fps[d][0]), cr = paired(c, cpu_ms[d][0]);
+        const MeanInterval fr = paired(f, fps[d][0]), cr = paired(c, cpu_ms[d][0]);
         fps_ratio = text(fr), cpu_ratio = text(cr);
         if (fr.hi < 1.0) {
           verdict_text = "**fps lower**";

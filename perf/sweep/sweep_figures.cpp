@@ -93,6 +93,7 @@ void write_sweep_figures(const std::vector<SweepRow>& rows, const SweepRun& run,
                                   {"drills", run.drills},
                                   {"variant_levels", run.variant_levels},
                                   {"threads", run.threads},
+                                  {"speedup_reps", run.speedup_reps},
                                   {"run_failures", run.run_failures},
                                   {"points", all}};
     std::ofstream(dir / "sweep_points.json") << saved.dump() << '\n';  // compact: ~1 MB indented
@@ -114,6 +115,7 @@ SweepRun read_saved_sweep(const fs::path& dir, std::vector<SweepRow>& rows) {
     run.drills = saved.at("drills").get<std::vector<std::string>>();
     run.variant_levels = saved.at("variant_levels").get<std::vector<int>>();
     run.threads = saved.at("threads").get<std::vector<int>>();
+    run.speedup_reps = saved.value("speedup_reps", 1);  // sweeps saved before the repeats: one
     run.run_failures = saved.at("run_failures").get<std::vector<std::string>>();
     for (const auto& j : saved.at("points")) {
       SweepRow row;

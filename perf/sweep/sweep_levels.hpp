@@ -28,9 +28,15 @@ struct LevelFigures {
   double cornea_cut_max_ms = 0;                    // the cornea_cut system's worst frame
   double p50_1 = 0, p99_1 = 0, max_1 = 0, mean_1 = 0;
   double p50_2 = 0, p99_2 = 0, max_2 = 0, mean_2 = 0;
-  double speedup = 0;    // mean_1 / mean_2
+  // The 2-thread speed-up of the mean frame: the mean over the level's paired runs (1-thread mean
+  // / 2-thread mean of the same repetition) and its 95 % interval; one pair without repeats.
+  double speedup = 0, speedup_lo = 0, speedup_hi = 0;
+  int speedup_pairs = 0;
   double error_pct = 0;  // default methods, 1 thread, against the reference
 };
+
+// "1.42× [1.30–1.55], 5": the speed-up, its 95 % interval and its pairs ("1.42×" from one pair).
+std::string speedup_text(const LevelFigures& g);
 
 // The default methods' figures of a drill at each level 0..max_level that ran (NaN where a figure
 // does not apply or a point is missing).

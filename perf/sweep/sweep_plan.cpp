@@ -59,6 +59,8 @@ SweepArgs parse_sweep_args(const StudyOptions& options) {
       a.reference_level = number(i, "--reference-level", 0, eye::kMaxLevel);
     } else if (o == "--reference-dt-divisor" && has_value) {
       a.reference_dt_divisor = number(i, "--reference-dt-divisor", 1, 64);
+    } else if (o == "--speedup-reps" && has_value) {
+      a.speedup_reps = number(i, "--speedup-reps", 1, 20);
     } else if (o == "--max-level" && has_value) {
       a.max_level = number(i, "--max-level", 1, eye::kMaxLevel);
     } else if (o == "--drill" && has_value) {
@@ -73,6 +75,8 @@ SweepArgs parse_sweep_args(const StudyOptions& options) {
       throw InputError("sweep: unknown option '" + o + "'");
     }
   }
+  if (a.speedup_reps > 0 && (a.reference || a.replot))
+    throw InputError("sweep: --speedup-reps goes with a sweep that measures");
   if ((a.reference_level >= 0 || a.reference_dt_divisor > 0) && !a.reference)
     throw InputError("sweep: --reference-level and --reference-dt-divisor go with --reference");
   return a;
@@ -157,11 +161,30 @@ SweepPlan plan_sweep(const SweepRun& run, bool quick, const fs::path& scenarios,
       }
     }
   }
+  // The speed-up's repeats: the capsulorhexis default points again, after everything else, so
+  // that a repetition is minutes away from the first and a slow spell of the machine does not
+  // pair with itself; the thread order alternates (ABBA) from one repetition to the next.
+  if (std::find(drills.begin(), drills.end(), "capsulorhexis") != drills.end()) {
+    const fs::path scenario = scenarios / "capsulorhexis_expert.json";
+    for (int rep = 2; rep <= run.speedup_reps; ++rep)
+      for (int level : levels)
+        for (size_t k = 0; k < threads.size(); ++k) {
+          const int t = rep % 2 == 0 ? threads[threads.size() - 1 - k] : threads[k];
+          plan.push_back(SweepPointConfig{.drill = "capsulorhexis",
+                                          .scenario = scenario,
+                                          .level = level,
+                                          .threads = t,
+                                          .variant = repeat_variant(rep),
+                                          .cache_dir = cache});
+        }
+  }
   return p;
 }
 
 std::string point_key(const SweepPointConfig& c) {
-  return c.drill + "/" + std::to_string(c.level) + "/" + c.variant;
+  // A repeat is the default point again: same key, so its state hash must be the same.
+  return c.drill + "/" + std::to_string(c.level) + "/" +
+         (is_repeat_variant(c.variant) ? std::string("default") : c.variant);
 }
 
 std::string point_label(const SweepPointConfig& c) {

@@ -1,7 +1,8 @@
 #pragma once
 // The sweep's plan (issue 9, issue 22 item 1): its options, the method alternatives each drill's
 // scene can choose, and the points to run: a mesh warm-up per (drill, level, layout), then every
-// level on each thread count, the thread-scaling variants, and the alternatives at a few levels.
+// level on each thread count, the thread-scaling variants, the alternatives at a few levels, and
+// the capsulorhexis repeats that the 2-thread speed-up is averaged over.
 #include <filesystem>
 #include <map>
 #include <string>
@@ -34,6 +35,7 @@ struct SweepArgs {
   bool reference = false;        // make perf/results/sweep_reference.json instead of sweeping
   int reference_level = -1;      // --reference-level
   int reference_dt_divisor = 0;  // --reference-dt-divisor
+  int speedup_reps = 0;          // --speedup-reps (0: the default, 5; --quick 1)
 };
 SweepArgs parse_sweep_args(const StudyOptions& options);
 
@@ -47,6 +49,9 @@ struct SweepRun {
   int max_level = 0;
   std::vector<std::string> drills;
   std::vector<int> threads, variant_levels;
+  // The capsulorhexis default points at every level on 1 and 2 threads run this many times in all
+  // (the first is the level's own point; the others are "repeat k" points at the plan's end).
+  int speedup_reps = 1;
   std::vector<std::string> run_failures;  // points that did not run to their end
   bool replot = false;                    // the report is redrawn from saved points
 };

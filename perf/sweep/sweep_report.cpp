@@ -325,7 +325,13 @@ std::string levels_md(const Section& s) {
       "\nCG iterations: physics.capsule's cg_iterations_per_step_mean where the run reports it, "
       "else cg_iterations_total over frames_stepped. The refresh chart's slopes are fitted "
       "against the drill's own elements over the levels run; the speed-up is the 1-thread "
-      "frame mean over the 2-thread one with the haptic thread beside both.\n\n";
+      "frame mean over the 2-thread one with the haptic thread beside both. Single runs of one "
+      "point differ by up to 40 % on this machine, so where the capsulorhexis points were "
+      "repeated (" +
+      std::to_string(s.run.speedup_reps) +
+      " runs of each, the repeats after every other point, thread order alternating) its "
+      "speed-up is the mean of the paired ratios with its 95 % interval (Student's t), and the "
+      "targets are judged on that mean; the frame columns are the first pair's.\n\n";
   return md;
 }
 

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -67,6 +68,25 @@ TEST(Report, ResultsAssembledInFixedOrderKeepingOtherSections) {
   const std::string again = assemble_results(dir.path, "| CPU | x |\n");
   EXPECT_NE(again.find("new"), std::string::npos);
   EXPECT_NE(again.find("## Foundation\n\nf"), std::string::npos);
+}
+
+// The interval studies report repeated runs with: Student's t on n − 1 degrees of freedom, checked
+// against values worked by hand.
+TEST(Report, MeanIntervalIsStudentsT) {
+  // {1, 2, 3}: mean 2, s = 1, half-width t(2) · s / √3 = 4.303 / 1.732.
+  const MeanInterval three = mean_interval95({1.0, 2.0, 3.0});
+  EXPECT_DOUBLE_EQ(three.mean, 2.0);
+  EXPECT_NEAR(three.hi - three.mean, 4.303 / std::sqrt(3.0), 1e-9);
+  EXPECT_NEAR(three.mean - three.lo, 4.303 / std::sqrt(3.0), 1e-9);
+  // Equal values: no spread, a point interval.
+  const MeanInterval same = mean_interval95({1.5, 1.5, 1.5, 1.5});
+  EXPECT_DOUBLE_EQ(same.lo, 1.5);
+  EXPECT_DOUBLE_EQ(same.hi, 1.5);
+  // One value: the mean, and an interval that says nothing.
+  const MeanInterval one = mean_interval95({0.9});
+  EXPECT_DOUBLE_EQ(one.mean, 0.9);
+  EXPECT_TRUE(std::isinf(one.lo) && std::isinf(one.hi));
+  EXPECT_TRUE(std::isnan(mean_interval95({}).mean));
 }
 
 }  // namespace

@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include "engine/core/error.hpp"
 #include "perf/sweep/sweep_data.hpp"
+#include "perf/sweep/sweep_levels.hpp"
+#include "perf/sweep/sweep_plan.hpp"
 #include "perf/sweep/sweep_point.hpp"
 #include "procedures/scene/run.hpp"
 
@@ -131,6 +134,58 @@ TEST(SweepPoint, AChildThatFailsOrCrashesIsReportedNotFatal) {
         << e.what();
   }
   fs::remove_all(dir);
+}
+
+// The 2-thread speed-up over repeated pairs (issue 17 item 7): the plan runs the capsulorhexis
+// default points again at its end, thread order alternating, each repeat keyed as the default
+// point (its state hash must match); a level's speed-up is the mean of its paired ratios.
+TEST(SweepSpeedup, RepeatsArePlannedLastAndAveragedPairByPair) {
+  SweepRun run;
+  run.max_level = 1;
+  run.drills = {"capsulorhexis", "corneal_incision"};
+  run.threads = {1, 2};
+  run.variant_levels = {};
+  run.speedup_reps = 3;
+  const SweepPlan plan = plan_sweep(run, true, "/scenarios", "/cache");
+  std::vector<const SweepPointConfig*> repeats;
+  size_t first_repeat = plan.points.size();
+  for (size_t i = 0; i < plan.points.size(); ++i)
+    if (is_repeat_variant(plan.points[i].variant)) {
+      repeats.push_back(&plan.points[i]);
+      first_repeat = std::min(first_repeat, i);
+    }
+  ASSERT_EQ(repeats.size(), 2u * 2u * 2u);  // repeats 2 and 3 × levels 0, 1 × 1 and 2 threads
+  EXPECT_EQ(plan.points.size() - first_repeat, repeats.size());  // all after the other points
+  for (const SweepPointConfig* c : repeats) {
+    EXPECT_EQ(c->drill, "capsulorhexis");
+    SweepPointConfig plain = *c;
+    plain.variant = "default";
+    EXPECT_EQ(point_key(*c), point_key(plain));
+  }
+  EXPECT_EQ(repeats[0]->variant, "repeat 2");
+  EXPECT_EQ(repeats[0]->threads, 2);  // repeat 2 starts with 2 threads, repeat 3 with 1
+  EXPECT_EQ(repeats[4]->variant, "repeat 3");
+  EXPECT_EQ(repeats[4]->threads, 1);
+
+  // Three pairs at level 0 with ratios 1.2, 1.5 and 1.8: the mean 1.5 and Student's interval.
+  std::vector<SweepRow> rows;
+  auto add = [&](const std::string& variant, int threads, double mean_ms) {
+    SweepRow row;
+    row.r = with_metrics("capsulorhexis", {{"score", 90.0}});
+    row.r.config.level = 0, row.r.config.threads = threads, row.r.config.variant = variant;
+    row.r.frame.mean_ms = mean_ms;
+    rows.push_back(row);
+  };
+  add("default", 1, 1.2), add("default", 2, 1.0);
+  add("repeat 2", 2, 1.0), add("repeat 2", 1, 1.5);
+  add("repeat 3", 1, 1.8), add("repeat 3", 2, 1.0);
+  const std::vector<LevelFigures> figs = level_figures(rows, "capsulorhexis", 0);
+  ASSERT_EQ(figs.size(), 1u);
+  EXPECT_EQ(figs[0].speedup_pairs, 3);
+  EXPECT_NEAR(figs[0].speedup, 1.5, 1e-12);
+  EXPECT_NEAR(figs[0].speedup_hi - 1.5, 4.303 * 0.3 / std::sqrt(3.0), 1e-9);
+  EXPECT_NEAR(figs[0].mean_1, 1.2, 1e-12);  // the frame columns are the first pair's
+  EXPECT_NE(speedup_text(figs[0]).find("], 3"), std::string::npos) << speedup_text(figs[0]);
 }
 
 }  // namespace
