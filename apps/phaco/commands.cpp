@@ -169,6 +169,10 @@ int run_with_haptics(const Args& a, const Scenario& scenario, const std::string&
     config.loop.spin_ns =
         static_cast<int64_t>(parse_seconds("run", "--spin-us", *spin, 0, 1000) * 1e3);
   }
+  if (auto most = a.option("--max-spin-us")) {
+    config.loop.max_spin_ns =
+        static_cast<int64_t>(parse_seconds("run", "--max-spin-us", *most, 0, 1000) * 1e3);
+  }
   HapticSession session(config);
   // --record: the device's samples become the stored recording (apps/phaco/haptic_record.hpp).
   const auto recording = HapticRecording::from_args(a, scenario, hand, spec_text);
@@ -213,11 +217,11 @@ std::optional<std::filesystem::path> record_target(const Args& a) {
 }
 
 int run(const std::vector<std::string>& raw) {
-  const Args a =
-      parse_args("run", raw,
-                 {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration",
-                  "--stall-at", "--stall-ms", "--spin-us", "--record", "--trainee", "--difficulty"},
-                 {"--json", "--no-rt"});
+  const Args a = parse_args(
+      "run", raw,
+      {"--threads", "--report", "--cache-dir", "--haptics", "--hand", "--duration", "--stall-at",
+       "--stall-ms", "--spin-us", "--max-spin-us", "--record", "--trainee", "--difficulty"},
+      {"--json", "--no-rt"});
   if (a.positional.size() != 1) throw InputError("run: give exactly one scenario file");
   if (is_procedure_file(a.positional[0]))
     return run_procedure_file(a, scene_options(a, "run"));  // docs/procedures.md
@@ -225,7 +229,8 @@ int run(const std::vector<std::string>& raw) {
   // A level of the drill file (docs/drills.md); checked when the scene is built.
   if (auto level = a.option("--difficulty")) scenario.difficulty = *level;
   if (auto spec = a.option("--haptics")) return run_with_haptics(a, scenario, *spec);
-  for (const char* o : {"--hand", "--duration", "--stall-at", "--stall-ms", "--spin-us"}) {
+  for (const char* o :
+       {"--hand", "--duration", "--stall-at", "--stall-ms", "--spin-us", "--max-spin-us"}) {
     if (a.option(o)) throw InputError(std::string("run: ") + o + " needs --haptics");
   }
   if (a.flag("--no-rt")) throw InputError("run: --no-rt needs --haptics");

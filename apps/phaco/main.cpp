@@ -35,8 +35,8 @@ usage:
       main port, the torn rhexis the opening, the sculpted trench the groove), each scored as its
       drill, and the total; a complication fails the procedure there and says why. With
       --trainee, each step that ran is stored as its drill's record.
-  phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--duration S]
-                 [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
+  phaco run FILE --haptics DEVICE [--hand left|right] [--no-rt] [--spin-us US] [--max-spin-us US]
+                 [--duration S] [--stall-at S --stall-ms MS] [--threads N] [--report OUT.json] [--json]
                  [--record DB --trainee NAME]
       Run the scenario in real time with the 1 kHz haptic thread; DEVICE drives one hand's tool
       and feels the force of the local haptic model (docs/haptics.md):
@@ -45,7 +45,9 @@ usage:
         udp:LOCALPORT@PEERHOST:PEERPORT  a device driven by another process (docs/udp_bridge_protocol.md)
         openhaptics[:NAME]               a Phantom-class device (only when built with the SDK)
       The haptic thread asks for SCHED_FIFO (--no-rt: it does not) and the summary says whether
-      it got it. --spin-us: the loop sleeps to the deadline minus this, then spins (default 60).
+      it got it. The loop sleeps to a margin before each deadline, then spins; the margin follows
+      the wake-up latency it observes, from --spin-us (default 60) up to --max-spin-us (default
+      250; set it to --spin-us for a fixed margin).
       --duration runs longer or shorter than the scenario (it restarts when it ends);
       --stall-at/--stall-ms make the simulation hang once, to show the force stays continuous.
       --record stores the scenario with the track the device produced (docs/records.md).

@@ -44,8 +44,8 @@ void record_steps(const std::filesystem::path& db, const std::string& trainee,
 }  // namespace
 
 int run_procedure_file(const Args& a, const SceneOptions& options) {
-  for (const char* o :
-       {"--haptics", "--hand", "--duration", "--stall-at", "--stall-ms", "--spin-us"}) {
+  for (const char* o : {"--haptics", "--hand", "--duration", "--stall-at", "--stall-ms",
+                        "--spin-us", "--max-spin-us"}) {
     if (a.option(o)) {
       throw InputError(std::string("run: ") + o +
                        " is for a drill scenario, not a procedure (docs/procedures.md: a live "

@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "engine/core/clock.hpp"
+#include "engine/haptics/spin_margin.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define PHACO_HAPTICS_SANITIZED 1
@@ -91,6 +92,8 @@ void HapticLoop::start(TickFn tick, void* context, const LoopSettings& settings)
   if (settings.period_ns <= 0)
     throw std::invalid_argument("HapticLoop::start: period_ns must be > 0");
   if (settings.spin_ns < 0) throw std::invalid_argument("HapticLoop::start: spin_ns must be >= 0");
+  if (settings.max_spin_ns < 0)
+    throw std::invalid_argument("HapticLoop::start: max_spin_ns must be >= 0");
   if (settings.warmup_ticks < 0)
     throw std::invalid_argument("HapticLoop::start: warmup_ticks must be >= 0");
   if (settings.realtime && (settings.priority < 1 || settings.priority > 99))
@@ -183,7 +186,9 @@ void HapticLoop::set_up_thread() {
 void HapticLoop::run() {
   set_up_thread();
   const int64_t period = settings_.period_ns;
-  const int64_t spin = settings_.spin_ns;
+  // spin_ns = 0 sleeps only, whatever max_spin_ns says; ≥ period spins only.
+  SpinMargin margin{.floor_ns = settings_.spin_ns,
+                    .cap_ns = settings_.spin_ns == 0 ? 0 : settings_.max_spin_ns};
   const int64_t warmup = settings_.warmup_ticks;
   // One period of margin before the first deadline, so tick 0 is not late by construction.
   start_ns_ = now_ns() + period;
@@ -197,15 +202,20 @@ void HapticLoop::run() {
   // Relaxed: the flag carries no data; stop() joins the thread afterwards.
   while (!stop_.load(std::memory_order_relaxed)) {
     const int64_t deadline = start_ns_ + k * period;
-    if (spin < period) {
-      const int64_t sleep_target = deadline - spin;
-      if (now_ns() < sleep_target) sleep_until(sleep_target);
+    if (const int64_t m = margin.margin_ns(); m < period) {
+      const int64_t sleep_target = deadline - m;
+      if (now_ns() < sleep_target) {
+        sleep_until(sleep_target);
+        margin.observe_sleep(now_ns() - sleep_target);
+      }
     }
     int64_t wake = now_ns();
+    const int64_t spin_from = wake;
     while (wake < deadline) {
       cpu_relax();
       wake = now_ns();
     }
+    margin.decay();
 
     tick_(context_, TickInfo{k, deadline, wake});
     const int64_t end = now_ns();
@@ -214,7 +224,7 @@ void HapticLoop::run() {
     const int64_t missed = (wake - deadline) / period;
     if (ticks_run >= warmup) {
       stats_.record_tick(previous_wake >= 0 ? wake - previous_wake : -1, wake - deadline,
-                         end - wake);
+                         end - wake, wake - spin_from);
       if (missed > 0) stats_.record_overrun(missed);
     }
     previous_wake = wake;

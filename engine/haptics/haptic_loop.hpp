@@ -4,10 +4,12 @@
 //
 // One thread ticks a caller's function on absolute deadlines, deadline_k = start + k·period, so
 // errors never accumulate (a relative sleep of one period drifts by every wake-up's lateness).
-// Each wait sleeps with clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME) until spin_ns before the
+// Each wait sleeps with clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME) until a margin before the
 // deadline, then spins on the clock to it: the sleep gives the core back, the spin absorbs the
-// kernel's wake-up latency. The thread asks for SCHED_FIFO and locked memory and reports what it
-// actually got (RealtimeStatus); without them the loop still runs, with worse figures.
+// kernel's wake-up latency. The margin follows that latency as the loop observes it, between
+// spin_ns and max_spin_ns (spin_margin.hpp): it grows when the cores are loaded. The thread asks
+// for SCHED_FIFO and locked memory and reports what it actually got (RealtimeStatus); without them
+// the loop still runs, with worse figures.
 //
 // A tick that wakes after the following deadline has passed is an overrun: the tick still runs
 // at once (the device needs a force), the deadlines already past are counted as missed and the
@@ -30,9 +32,11 @@ namespace phaco {
 struct LoopSettings {
   int64_t period_ns = 1'000'000;  // 1 kHz
   int64_t spin_ns =
-      60'000;  // sleep to deadline − spin_ns, then spin; 0 = sleep only, ≥ period = spin
-  bool realtime = true;        // ask for SCHED_FIFO
-  int priority = 80;           // SCHED_FIFO priority, 1–99
+      60'000;  // sleep to deadline − margin, then spin; 0 = sleep only, ≥ period = spin only
+  int64_t max_spin_ns = 250'000;  // the margin grows with the observed wake-up latency up to
+                                  // this (spin_margin.hpp); ≤ spin_ns: a fixed margin of spin_ns
+  bool realtime = true;           // ask for SCHED_FIFO
+  int priority = 80;              // SCHED_FIFO priority, 1–99
   bool lock_memory = true;     // mlockall(MCL_CURRENT | MCL_FUTURE): no page faults on the hot path
   int cpu = -1;                // pin the thread to this CPU if ≥ 0
   int64_t warmup_ticks = 200;  // first ticks run but are not counted in the statistics

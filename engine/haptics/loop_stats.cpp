@@ -106,10 +106,12 @@ std::vector<DurationHistogram::Bin> DurationHistogram::occupied_bins() const {
   return out;
 }
 
-void LoopStats::record_tick(int64_t period_ns, int64_t lateness_ns, int64_t compute_ns) {
+void LoopStats::record_tick(int64_t period_ns, int64_t lateness_ns, int64_t compute_ns,
+                            int64_t spin_ns) {
   if (period_ns >= 0) period_.record(period_ns);
   lateness_.record(lateness_ns);
   compute_.record(compute_ns);
+  spin_.record(spin_ns);
   bump(ticks_, 1);
 }
 
@@ -122,6 +124,7 @@ void LoopStats::reset() {
   period_.reset();
   lateness_.reset();
   compute_.reset();
+  spin_.reset();
   ticks_.store(0, std::memory_order_relaxed);
   overruns_.store(0, std::memory_order_relaxed);
   missed_.store(0, std::memory_order_relaxed);
@@ -132,6 +135,7 @@ LoopStatsSnapshot LoopStats::snapshot() const {
   s.period = period_.summary();
   s.lateness = lateness_.summary();
   s.compute = compute_.summary();
+  s.spin = spin_.summary();
   // Relaxed: statistics only.
   s.ticks = ticks_.load(std::memory_order_relaxed);
   s.overruns = overruns_.load(std::memory_order_relaxed);

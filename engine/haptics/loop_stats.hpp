@@ -1,6 +1,7 @@
 #pragma once
 // Timing statistics of the 1 kHz haptic loop (issue 6 item 1): the period between wake-ups, the
-// wake-up lateness (wake time − deadline), the tick's own compute time, and overruns.
+// wake-up lateness (wake time − deadline), the tick's own compute time, the time spun before each
+// deadline, and overruns.
 //
 // Each distribution is a fixed histogram of microsecond bins, allocated once in the constructor,
 // so recording never allocates, locks or calls the system:
@@ -37,6 +38,7 @@ struct LoopStatsSnapshot {
   DurationSummary period;        // wake-up to wake-up of consecutive ticks
   DurationSummary lateness;      // wake-up time − deadline
   DurationSummary compute;       // the tick function's own time
+  DurationSummary spin;          // time spun before the deadline (the wait's margin, its CPU cost)
   int64_t ticks = 0;             // ticks recorded (warm-up excluded)
   int64_t overruns = 0;          // ticks that woke after the following deadline had already passed
   int64_t missed_deadlines = 0;  // deadlines skipped by those overruns (no catch-up burst)
@@ -82,7 +84,7 @@ class DurationHistogram {
 class LoopStats {
  public:
   // period_ns < 0: no previous tick to measure a period from.
-  void record_tick(int64_t period_ns, int64_t lateness_ns, int64_t compute_ns);
+  void record_tick(int64_t period_ns, int64_t lateness_ns, int64_t compute_ns, int64_t spin_ns = 0);
   // One overrun that skipped `missed` deadlines.
   void record_overrun(int64_t missed);
   void reset();  // not while recording
@@ -90,7 +92,7 @@ class LoopStats {
   const DurationHistogram& period() const { return period_; }
 
  private:
-  DurationHistogram period_, lateness_, compute_;
+  DurationHistogram period_, lateness_, compute_, spin_;
   std::atomic<int64_t> ticks_{0}, overruns_{0}, missed_{0};
 };
 

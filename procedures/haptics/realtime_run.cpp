@@ -158,6 +158,7 @@ nlohmann::json to_json(const HapticSessionStats& s) {
           {"period", summary_json(s.loop.period)},
           {"lateness", summary_json(s.loop.lateness)},
           {"compute", summary_json(s.loop.compute)},
+          {"spin", summary_json(s.loop.spin)},
           {"models_published", s.models_published},
           {"hands", hands}};
 }
@@ -199,6 +200,7 @@ std::string summary_text(const RealtimeRunReport& r) {
   out += line("period", s.loop.period);
   out += line("lateness", s.loop.lateness);
   out += line("compute", s.loop.compute);
+  out += line("spin", s.loop.spin);
   for (size_t k = 0; k < s.hands.size(); ++k) {
     const HapticHandStats& h = s.hands[k];
     if (!h.attached) continue;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "engine/haptics/haptic_loop.hpp"
+#include "engine/haptics/spin_margin.hpp"
 
 namespace phaco {
 namespace {
@@ -83,6 +84,9 @@ TEST(HapticLoop, AbsoluteDeadlinesIncreasingIndicesAndExactAccounting) {
   EXPECT_EQ(s.lateness.count, s.ticks);
   EXPECT_EQ(s.compute.count, s.ticks);
   EXPECT_EQ(s.period.count, s.ticks);  // the first counted tick measures from the last warm-up one
+  EXPECT_EQ(s.spin.count, s.ticks);
+  // Time spun per tick: counted for every tick, never negative.
+  EXPECT_GE(s.spin.min_us, 0.0);
   EXPECT_EQ(s.overruns, overruns);
   EXPECT_EQ(s.missed_deadlines, missed_total);
   EXPECT_GE(s.lateness.min_us, 0.0);
@@ -124,11 +128,44 @@ TEST(HapticLoop, RejectsBadSettings) {
   s.spin_ns = -1;
   EXPECT_THROW(loop.start(&Recorder::tick, &r, s), std::invalid_argument);
   s = quiet_settings();
+  s.max_spin_ns = -1;
+  EXPECT_THROW(loop.start(&Recorder::tick, &r, s), std::invalid_argument);
+  s = quiet_settings();
   s.realtime = true;
   s.priority = 0;
   EXPECT_THROW(loop.start(&Recorder::tick, &r, s), std::invalid_argument);
   EXPECT_THROW(loop.start(nullptr, &r, quiet_settings()), std::invalid_argument);
   EXPECT_FALSE(loop.running());
+}
+
+// The wait's margin (spin_margin.hpp): the floor when sleeps return on time; raised within the
+// tick to cover a late sleep; back to the floor once sleeps are on time again; never past the
+// cap; and a fixed margin when the cap is the floor.
+TEST(SpinMargin, FollowsTheObservedWakeUpLatencyBetweenFloorAndCap) {
+  SpinMargin m{.floor_ns = 60'000, .cap_ns = 250'000};
+  EXPECT_EQ(m.margin_ns(), 60'000);
+  m.observe_sleep(10'000);  // on time: the floor still covers it
+  m.decay();
+  EXPECT_EQ(m.margin_ns(), 60'000);
+  m.observe_sleep(110'000);           // a loaded core: 110 µs late
+  EXPECT_EQ(m.margin_ns(), 130'000);  // the overshoot plus the 20 µs guard, at once
+  m.observe_sleep(-5'000);            // a negative reading (clock granularity) is no overshoot
+  EXPECT_EQ(m.margin_ns(), 130'000);
+  int ticks = 0;
+  while (m.margin_ns() > 60'000 && ticks < 100'000) m.decay(), ++ticks;
+  EXPECT_GT(ticks, 200);       // remembered for a while: the load comes back
+  EXPECT_LT(ticks, 2'000);     // but gone within two seconds at 1 kHz
+  m.observe_sleep(5'000'000);  // the vCPU descheduled for 5 ms: no spin can cover that
+  EXPECT_EQ(m.margin_ns(), 250'000);
+  ticks = 0;
+  while (m.margin_ns() > 60'000 && ticks < 100'000) m.decay(), ++ticks;
+  EXPECT_LT(ticks, 1'000);  // counted as the cap, not as 5 ms: back at the floor within a second
+  SpinMargin fixed{.floor_ns = 60'000, .cap_ns = 60'000};
+  fixed.observe_sleep(200'000);
+  EXPECT_EQ(fixed.margin_ns(), 60'000);
+  SpinMargin sleep_only{.floor_ns = 0, .cap_ns = 0};
+  sleep_only.observe_sleep(200'000);
+  EXPECT_EQ(sleep_only.margin_ns(), 0);
 }
 
 TEST(HapticLoop, WithoutRealtimeReportsNotRequested) {
