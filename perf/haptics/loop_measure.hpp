@@ -44,8 +44,8 @@ struct LoopMeasureRow {
   LoopStatsSnapshot stats;  // period, lateness, compute (µs), overruns
 };
 
-// Realtime on and off, each with sleep + 60 µs spin and with sleep only, all with a busy load on
-// the other core (the loop pinned to CPU 0, the load to CPU 1).
+// Realtime on and off, each with sleep + a fixed 60 µs spin, sleep + the adaptive 60–250 µs spin
+// (the default) and sleep only, all with a busy load on the other core, pinned apart.
 std::vector<LoopMeasureCase> default_loop_cases(double seconds, int64_t work_ns = 50'000);
 
 LoopMeasureRow measure_loop(const LoopMeasureCase& c);
