@@ -80,6 +80,7 @@ struct CapsuleCutting {
   // open tear, its force as the tear saw it, and the steps the tear took.
   bool tearing = false;
   double flap_force_mn = 0.0;
+  double held_pull_mn = 0.0;  // the held flap's pull after the fold: where the dynamics start
   uint32_t tear_steps_last_frame = 0;
   uint64_t max_tear_steps_per_frame = 0;
   // Springs (edge key) the held flap folded this frame, with their own rest lengths.

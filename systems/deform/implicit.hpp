@@ -107,8 +107,9 @@ struct ImplicitSettings {
   bool warm_start = true;
   CgOperator cg_operator =
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
-  // Block-Jacobi: Deflation needs ≤ 40 CG iterations per frame at about its cost, but its answer
-  // at the same tolerance spiked a tear frame's forceps force (docs/implicit_and_active.md).
+  // Block-Jacobi: Deflation needs ≤ 40 CG iterations per frame at about its cost on one thread,
+  // but runs in Eigen's CG on one thread, where block-Jacobi's runs on the step's team of two
+  // (docs/implicit_and_active.md).
   Preconditioner preconditioner = Preconditioner::BlockJacobi;
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a

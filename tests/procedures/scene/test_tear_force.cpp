@@ -2,10 +2,11 @@
 // capsule_cutting): with the scripted expert (data/scenarios/capsulorhexis_expert.json) the force
 // the forceps exert on the flap while tearing has an RMS inside the expert band, 6–14 mN
 // (surgeons with force-sensing forceps ≈ 9 mN), and no frame's force rises above the capsule's
-// tear resistance F_c by more than the plateau margin (the dynamics answer the tear a frame
-// late: measured 1.30·F_c at worst). The scripted novices are the expert's hands moved, scaled or
-// turned outward; the tear caps their force at the same plateau (their RMS is not the surgeons'
-// ≈ 17 mN, which is voluntary force beyond what the tear needs).
+// tear resistance F_c by more than the plateau margin (the held flap folds at F_c after the
+// frame's edits, and the dynamics relax it from there: measured 1.02·F_c at worst with block-Jacobi
+// and deflation; 1.30–1.48·F_c while the fold came before the edits). The scripted novices are the
+// expert's hands moved, scaled or turned outward; the tear caps their force at the same plateau
+// (their RMS is not the surgeons' ≈ 17 mN, which is voluntary force beyond what the tear needs).
 // Whole runs: skipped under ASan like the other drill tests.
 #include <gtest/gtest.h>
 
@@ -21,7 +22,7 @@
 namespace phaco {
 namespace {
 
-constexpr double kPlateauMargin = 0.35;  // as perf/study_tear.cpp
+constexpr double kPlateauMargin = 0.1;
 
 struct TearForce {
   double resistance_mn = 0, rms = 0, max = 0, tearing_s = 0;
