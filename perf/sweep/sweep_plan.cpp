@@ -21,6 +21,7 @@ std::vector<Variant> variants_of(const std::string& drill) {
     for (const char* i :
          {"implicit_predictor", "semi_implicit_001", "symplectic_euler", "explicit_euler", "xpbd"})
       method("capsule.integrator", i);
+    method("capsule.preconditioner", "deflation");  // ≤ 40 CG iterations (issue 17 item 2)
     method("capsule.stiffness", "uniform");
     method("capsule.spring_law", "quadratic");
     method("capsule.active_set", "off");
