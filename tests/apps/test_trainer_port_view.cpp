@@ -57,17 +57,20 @@ constexpr const char* kRhexisMoves = "down12 520,560 490,240 620,250";
 constexpr const char* kScript = R"sh(
 S="$1"; M="$2"; shift 2
 tip() { tr -d ' \n' < "$D/state.json" 2>/dev/null | grep -o '"selected":true,"tip_mm":\[[^]]*\]'; }
+# The trainer polls the keys once a frame: a key held 0.3 s is seen even in a slow frame (a bare
+# `xdotool key` can go down and up between two polls, and F12 was once missed so).
+press() { xdotool keydown "$1"; sleep 0.3; xdotool keyup "$1"; }
 "$T" --scenario "$S" --duration 120 --size 1280x720 --no-guidance --ui-state "$D/state.json" \
   --views "$D" "$@" > "$D/trainer.log" 2>&1 &
 P=$!
 started
 xdotool mousemove 640 400; wait_for '"controls_shown": true'
-xdotool key F1; wait_for '"controls_shown": false'
+press F1; wait_for '"controls_shown": false'
 sleep 1  # a frame with the pointer over the view and no overlay: the clutch engages
 n=0
 for at in $M; do
   case "$at" in
-    tab) xdotool key Tab; wait_for '"active_hand": "left"'; sleep 0.5; continue ;;
+    tab) press Tab; wait_for '"active_hand": "left"'; sleep 0.5; continue ;;
     down*) xdotool click --repeat "${at#down}" --delay 50 4; sleep 1.5; continue ;;  # deeper
   esac
   # The view is saved once the active tool shows the move (a frame of the nucleus scene on a
@@ -75,9 +78,9 @@ for at in $M; do
   before=$(tip); xdotool mousemove ${at/,/ }
   for i in $(seq 300); do [ "$(tip)" != "$before" ] && break; sleep 0.1; done
   sleep 0.5
-  n=$((n + 1)); xdotool key F12; wait_for "\"views_saved\": $n"
+  n=$((n + 1)); press F12; wait_for "\"views_saved\": $n"
 done
-xdotool key Escape
+press Escape
 wait $P
 echo "trainer exit $?"
 )sh";
