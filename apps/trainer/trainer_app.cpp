@@ -388,6 +388,10 @@ std::array<float, 4> start_imgui(GLFWwindow* window, const TrainerOptions& o) {
   if (o.ui) load_font();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330");
+  // Tab switches hands (read_input). ImGui's tabbing also took it, putting a focused panel's
+  // first field (a slider or a text field) into text entry, after which every key (F12, Space,
+  // R…) went to the field, not to the trainer. Panels are worked with the mouse.
+  ImGui::GetIO().KeyMap[ImGuiKey_Tab] = -1;
   // Every glyph and panel lands on whole pixels (ImGui floors text and window positions), so the
   // atlas sampled nearest draws what bilinear filtering would, for a quarter of llvmpipe's texel
   // fetches; lines are anti-aliased by geometry, not by filtering the atlas's baked lines.

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "engine/core/error.hpp"
+#include "engine/io/tool_shape.hpp"
 #include "engine/render/offscreen.hpp"
 
 namespace phaco::trainer {
@@ -46,11 +47,15 @@ void write_view_poses(const std::filesystem::path& file, const render::RenderSna
   const Quat& g = snap.globe_rotation;
   j["globe_rotation_wxyz"] = {g.w(), g.x(), g.y(), g.z()};
   j["tools"] = nlohmann::json::array();
-  for (const render::ToolView& t : snap.tools)
+  for (const render::ToolView& t : snap.tools) {
+    // The shaft's axis as drawn: beside the tip by a bent point (engine/io/tool_shape).
+    const ShaftAxis axis = shaft_axis({t.tip_mm, t.quat, 0, 0}, t.kind);
     j["tools"].push_back({{"hand", std::string(to_string(t.hand))},
                           {"tool", std::string(to_string(t.kind))},
                           {"tip_mm", xyz(t.tip_mm)},
-                          {"shaft", xyz(t.quat.normalized() * Vec3::UnitZ())}});
+                          {"shaft", xyz(axis.direction)},
+                          {"shaft_point_mm", xyz(axis.point)}});
+  }
   write_json_file(file, j, "the view's poses");
 }
 

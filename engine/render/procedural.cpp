@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "engine/core/math.hpp"
+#include "engine/io/tool_shape.hpp"
 
 namespace phaco::render {
 namespace {
@@ -147,25 +148,30 @@ ToolMeshes make_tool_mesh(ToolKind kind) {
       add_tube(t.body, Vec3f(0, 0, 4.0f), Vec3f(0, 0, L), 0.3f, 0.6f);
       break;
     }
-    case ToolKind::Cystotome:
-      // 27 G needle with its point bent at a right angle (0.3 mm).
-      add_tube(t.body, Vec3f(0, 0, 0), Vec3f(0, 0.3f, 0), 0.05f, 0.2f, 10);
-      add_sphere(t.body, Vec3f(0, 0.3f, 0), 0.2f);
-      add_tube(t.body, Vec3f(0, 0.3f, 0), Vec3f(0, 0.3f, L), 0.2f, 0.2f);
+    case ToolKind::Cystotome: {
+      // 27 G needle with its point bent at a right angle; the shaft's axis is where
+      // engine/io/tool_shape says, which the ports hold.
+      const Vec3f bend = shaft_offset_local(kind).cast<float>();
+      add_tube(t.body, Vec3f(0, 0, 0), bend, 0.05f, 0.2f, 10);
+      add_sphere(t.body, bend, 0.2f);
+      add_tube(t.body, bend, bend + Vec3f(0, 0, L), 0.2f, 0.2f);
       break;
+    }
     case ToolKind::PhacoProbe:
       // The 0.9 mm titanium tip, then the wider irrigation sleeve.
       add_tube(t.body, Vec3f(0, 0, 0), Vec3f(0, 0, kPhacoTipLength + 0.2f), 0.45f, 0.45f);
       add_tube(t.body, Vec3f(0, 0, kPhacoTipLength), Vec3f(0, 0, L), 0.65f, 0.9f);
       break;
     case ToolKind::Hook:
-    case ToolKind::Chopper:
-      // Chopper / Sinskey hook: a 1 mm bent end on a thin shaft (the nucleus_removal drill's
-      // second instrument, issue 19).
-      add_tube(t.body, Vec3f(0, 0, 0), Vec3f(0, 1.0f, 0), 0.12f, 0.16f, 10);
-      add_sphere(t.body, Vec3f(0, 1.0f, 0), 0.17f);
-      add_tube(t.body, Vec3f(0, 1.0f, 0), Vec3f(0, 1.0f, L), 0.17f, 0.4f);
+    case ToolKind::Chopper: {
+      // Chopper / Sinskey hook: a bent end on a thin shaft (the nucleus_removal drill's second
+      // instrument, issue 19); the bend is engine/io/tool_shape's, as for the cystotome.
+      const Vec3f bend = shaft_offset_local(kind).cast<float>();
+      add_tube(t.body, Vec3f(0, 0, 0), bend, 0.12f, 0.16f, 10);
+      add_sphere(t.body, bend, 0.17f);
+      add_tube(t.body, bend, bend + Vec3f(0, 0, L), 0.17f, 0.4f);
       break;
+    }
     case ToolKind::Aspirator:
       // Irrigation/aspiration tip: closed round end.
       add_sphere(t.body, Vec3f(0, 0, 0.45f), 0.45f);

@@ -165,7 +165,10 @@ struct Renderer::Impl {
   double iris_baked_ratio = -1;
   std::vector<BodySlot> bodies;
   std::unique_ptr<LensReflexMap> lens_map;  // the lens looks' thickness map (lens_reflex.hpp)
-  ToolSlot tool_bodies[6], tool_jaw;
+  // One per ToolKind, the chopper (the last) included: with six, the chopper was drawn from
+  // past the array's end (the forceps' jaw, straight, where its bent point should be).
+  static constexpr int kToolKinds = static_cast<int>(ToolKind::Chopper) + 1;
+  ToolSlot tool_bodies[kToolKinds], tool_jaw;
   GLuint overlay_vao = 0, overlay_vbo = 0;
   size_t overlay_capacity = 0;  // vertices
   GLuint cover_vao = 0, cover_vbo = 0;
@@ -669,7 +672,7 @@ Renderer::Renderer(const RenderOptions& options) : impl_(new Impl), options_(opt
     im.iris_polar[1] = make_iris_texture(true);
     glGenTextures(1, &im.iris_texture);
     im.sclera_texture = Impl::make_texture(make_sclera_texture());
-    for (int k = 0; k < 6; ++k) {
+    for (int k = 0; k < Impl::kToolKinds; ++k) {
       const ToolMeshes meshes = make_tool_mesh(static_cast<ToolKind>(k));
       im.make_tool(im.tool_bodies[k], meshes.body);
       if (static_cast<ToolKind>(k) == ToolKind::Forceps) im.make_tool(im.tool_jaw, meshes.jaw);
@@ -710,11 +713,12 @@ Renderer::~Renderer() {
     const GLuint buffers[4] = {slot.positions, slot.normals, slot.indices, slot.pieces};
     glDeleteBuffers(4, buffers);
   }
-  for (auto* slot : {&im.tool_bodies[0], &im.tool_bodies[1], &im.tool_bodies[2], &im.tool_bodies[3],
-                     &im.tool_bodies[4], &im.tool_bodies[5], &im.tool_jaw}) {
-    glDeleteVertexArrays(1, &slot->vao);
-    glDeleteBuffers(3, slot->buffers);
+  for (auto& slot : im.tool_bodies) {
+    glDeleteVertexArrays(1, &slot.vao);
+    glDeleteBuffers(3, slot.buffers);
   }
+  glDeleteVertexArrays(1, &im.tool_jaw.vao);
+  glDeleteBuffers(3, im.tool_jaw.buffers);
   glDeleteVertexArrays(1, &im.overlay_vao);
   glDeleteBuffers(1, &im.overlay_vbo);
   glDeleteVertexArrays(1, &im.cover_vao);

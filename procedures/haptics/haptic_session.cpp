@@ -6,6 +6,7 @@
 
 #include "engine/core/clock.hpp"
 #include "engine/haptics/sample_bounds.hpp"
+#include "engine/io/tool_shape.hpp"
 
 namespace phaco {
 namespace {
@@ -129,11 +130,16 @@ void HapticSession::tick(const TickInfo& info) {
     Vec3 force = Vec3::Zero();
     if (h.have_sample && (health == DeviceHealth::Ok || health == DeviceHealth::Ended)) {
       // The shaft the device holds (local +z, tip → handle): the port's lever (issue 20 item 2).
-      const Vec3 shaft = h.sample.quat.coeffs().allFinite() && h.sample.quat.norm() > 1e-9
-                             ? Vec3(h.sample.quat.normalized() * Vec3::UnitZ())
-                             : Vec3::Zero();
+      // Its axis runs beside the tip by the tool's bent point, turned with the device
+      // (engine/io/tool_shape): the line the port holds, as the scene's tool_ports does.
+      const bool oriented = h.sample.quat.coeffs().allFinite() && h.sample.quat.norm() > 1e-9;
+      const Quat q = oriented ? h.sample.quat.normalized() : Quat::Identity();
+      const Vec3 shaft = oriented ? Vec3(q * Vec3::UnitZ()) : Vec3::Zero();
+      const Vec3 bend = oriented
+                            ? Vec3(q * shaft_offset_local(static_cast<ToolKind>(tool.tool_kind)))
+                            : Vec3::Zero();
       const haptic_model::HapticForce f = haptic_model::haptic_tick(
-          tool, h.sample.pos_mm, h.velocity, shaft, config_.model, *h.state);
+          tool, h.sample.pos_mm, h.velocity, shaft, bend, config_.model, *h.state);
       force = f.force_mn;
       if (f.clamped) h.clamped.fetch_add(1, std::memory_order_relaxed);
       if (f.input_rejected) h.rejected.fetch_add(1, std::memory_order_relaxed);

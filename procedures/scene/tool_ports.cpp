@@ -7,6 +7,7 @@
 
 #include "components/tool.hpp"
 #include "engine/core/error.hpp"
+#include "engine/io/tool_shape.hpp"
 #include "procedures/eye/eye_geometry.hpp"
 #include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/scene.hpp"
@@ -142,9 +143,12 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
         for (size_t i = 0; i < n; ++i) {
           const ToolState& pose = scene.world.at<ToolState>(scene.tools[i]);
           tool_eye::HandPose& h = hands[i];
-          h.tip_mm = pose.pos;
-          h.shaft = pose.quat.normalized() * Vec3::UnitZ();
           const ToolKind kind = scene.world.at<Tool>(scene.tools[i]).kind;
+          // The tunnel holds the drawn shaft: its axis, beside the tip by a bent point.
+          const ShaftAxis axis = shaft_axis(pose, kind);
+          h.tip_mm = pose.pos;
+          h.shaft = axis.direction;
+          h.axis_offset_mm = axis.point - pose.pos;
           // The phaco probe's and the chopper's work is inside the nucleus (its trenches and
           // cracks): the lens is no boundary for them. With the spring, the chopper down in the
           // trench (2.8 mm inside the uncut lens's surface) pressed the side port 147 mN and
@@ -153,11 +157,11 @@ std::optional<SystemDesc> tool_ports_system(Scene& scene) {
           // The keratome cuts its tunnel (cornea_cutting), it does not pass through one: the
           // ports model finished incisions, and a blade pressed through the slit "across" would
           // be read as a tunnel pushed on (82 mN for the incision expert) when it is the cut.
-          h.port =
-              kind == ToolKind::Keratome
-                  ? -1
-                  : tool_eye::engaged_port(rec->ports, globe.rotation, rec->eye.globe_centre_mm,
-                                           h.tip_mm, h.shaft, globe.tools[i].port);
+          h.port = kind == ToolKind::Keratome
+                       ? -1
+                       : tool_eye::engaged_port(rec->ports, globe.rotation,
+                                                rec->eye.globe_centre_mm, h.tip_mm, h.shaft,
+                                                globe.tools[i].port, h.axis_offset_mm);
         }
         tool_eye::solve(rec->ports, rec->eye, rec->stiffness,
                         std::span<const tool_eye::HandPose>(hands.data(), n), globe);

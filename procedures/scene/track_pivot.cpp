@@ -38,6 +38,7 @@ std::array<std::optional<TrackPivot>, 2> track_pivots(const Scene& scene) {
     throw InputError(scene.scenario.source + ": eye: " + e.what());
   }
   p.to = *scene.carried.main_port;
+  p.tool = right->tool;
   out[static_cast<size_t>(Hand::Right) & 1u] = p;
   return out;
 }
@@ -55,7 +56,7 @@ ToolState pivot_track(const ToolState& pose, const TrackPivot& p) {
     out.pos = pose.pos + w * (moved - pose.pos);
     out.quat = q.slerp(w, (Quat(r) * q).normalized()).normalized();
   }
-  return pivot_in_port(out, p.to, p.aim_mm);
+  return pivot_in_port(out, p.to, p.tool, p.aim_mm);
 }
 
 void pivot_track_pose(ToolState& pose, const std::optional<TrackPivot>& pivot) {

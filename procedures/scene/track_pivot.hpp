@@ -34,6 +34,7 @@ struct Scene;
 // and past it the shaft goes through the centre, however the tip blends.
 struct TrackPivot {
   EyePort from, to;
+  ToolKind tool = ToolKind::PhacoProbe;  // whose shaft is aimed (a bent point's axis)
   double carried_mm = 0.5, blend_mm = 2.0, aim_mm = 0.5;
 };
 

@@ -96,7 +96,8 @@ DesktopInput::DesktopInput(const DesktopMapping& mapping) : mapping_(mapping) {
 void DesktopInput::publish(Hand hand) {
   Slot& s = slots_[at(hand)];
   const auto& port = port_[at(hand)];
-  const ToolPose p = port ? pivot_in_port(pose_[at(hand)], *port) : pose_[at(hand)];
+  const ToolPose p =
+      port ? pivot_in_port(pose_[at(hand)], *port, tool_[at(hand)]) : pose_[at(hand)];
   const uint64_t seq = s.seq.load(std::memory_order_relaxed);
   s.seq.store(seq + 1, std::memory_order_relaxed);  // odd: a write in progress
   // Release fence: a reader that sees any field below also sees the odd sequence first.

@@ -54,7 +54,8 @@ port_of = {"left": "side", "right": "main"}
 centres = ports.default_ports(s["drill"])
 for name, hand in s["hands"].items():
     centre, axis = centres[port_of[name]]
-    hand["track"] = ports.pivot_track(hand["track"], centre, axis, ports.inside_eye())
+    hand["track"] = ports.pivot_track(hand["track"], centre, axis, ports.inside_eye(),
+                                      bend=ports.BEND_MM.get(hand["tool"], 0.0))
 s["name"], s["description"] = args.name, args.description
 text = json.dumps(s, indent=2)
 # one sample per line, as the other scenarios

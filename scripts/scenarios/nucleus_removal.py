@@ -38,7 +38,10 @@ P = ports.default_ports("nucleus_removal")
 main, main_axis = P["main"]
 side, side_axis = P["side"]
 rest_p = [main[i] + 0.25 * main_axis[i] for i in range(3)]
-rest_c = [side[i] + 0.25 * side_axis[i] for i in range(3)]
+# The chopper rests deeper: its shaft's axis runs 1 mm beside its tip (the bent point, ports.py
+# BEND_MM), and with the tip nearer the side port's centre than that the axis could pass the
+# centre only across the tunnel; 0.25 mm in, it pressed the port 150 mN.
+rest_c = [side[i] + (ports.BEND_MM["chopper"] + 1.25) * side_axis[i] for i in range(3)]
 
 def inward(centre, r, z):
     """A point on the port's azimuth at radius r and height z: in the pupil, above the iris."""
@@ -119,7 +122,7 @@ both(0.8, rest_p, 0, rest_c)
 
 inside = ports.inside_eye()
 probe = ports.pivot_track(probe, main, main_axis, inside)
-chop = ports.pivot_track(chop, side, side_axis, inside)
+chop = ports.pivot_track(chop, side, side_axis, inside, bend=ports.BEND_MM["chopper"])
 sc = {
   "name": args.name,
   "description": args.description,

@@ -88,18 +88,45 @@ def swing(a, b):
     return qunit([1 + c] + ax)
 
 
+# The bent points (engine/io/tool_shape.hpp): the shaft's axis runs this far beside the tip, along
+# the tool frame's +y. The pivot is about the drawn shaft, so it is that axis that is aimed.
+BEND_MM = {"cystotome": 0.3, "chopper": 1.0, "hook": 1.0}
+
+
+def rotate(q, v):
+    """v turned by the unit quaternion q."""
+    u = qunit(q)
+    return qmul(qmul(u, [0.0] + list(v)), [u[0], -u[1], -u[2], -u[3]])[1:]
+
+
 def offset_from(tip, shaft, centre):
     """Distance of the shaft's line from the port centre, mm."""
     d = sub(centre, tip)
     return norm(sub(d, mul(dot(d, shaft), shaft)))
 
 
-def aimed(tip, q, centre, axis):
+def axis_offset(tip, q, centre, bend=0.0):
+    """Distance of the shaft's axis (through tip + q·(0, bend, 0)) from the port centre, mm."""
+    return offset_from(add(tip, rotate(q, [0.0, bend, 0.0])), shaft_of(q), centre)
+
+
+def aimed(tip, q, centre, axis, bend=0.0, blend_mm=1.0):
     """q turned so that the shaft from `tip` passes through `centre`. A tip at the centre or out
-    past it (the tool not yet in, or in the tunnel) takes the tunnel's outward axis."""
+    past it (the tool not yet in, or in the tunnel) takes the tunnel's outward axis. With a bent
+    point it is the shaft's axis, `bend` beside the tip, that is aimed, as
+    procedures/scene/port_pivot does: from `bend` past the centre, blended in over `blend_mm`
+    from the line through the tip (closer in, the axis could pass the centre only across the
+    tunnel)."""
     d = sub(centre, tip)
-    want = unit(d) if dot(d, mul(-1, axis)) > 1e-6 else mul(-1, axis)
-    return qunit(qmul(swing(shaft_of(q), want), qunit(q)))
+    past = dot(d, mul(-1, axis))
+    want = unit(d) if past > 1e-6 else mul(-1, axis)
+    line = qunit(qmul(swing(shaft_of(q), want), qunit(q)))
+    w = min(1.0, max(0.0, (past - bend) / blend_mm))
+    if bend == 0 or w <= 0:
+        return line
+    s = math.sqrt(max(0.0, dot(d, d) - bend * bend))
+    full = qunit(qmul(swing(unit(rotate(q, [0.0, bend, s])), unit(d)), qunit(q)))
+    return slerp(line, full, w)
 
 
 def slerp(a, b, u):
@@ -116,10 +143,11 @@ def slerp(a, b, u):
 def lerp(a, b, u): return [a[i] + u * (b[i] - a[i]) for i in range(len(a))]
 
 
-def pivot_track(track, centre, axis, inside, tol_mm=0.01, max_depth=8):
+def pivot_track(track, centre, axis, inside, tol_mm=0.01, max_depth=8, bend=0.0):
     """Aims every sample whose tip satisfies inside(tip) through `centre`, and inserts samples
     (the engine's interpolation of pos, grip and pedal) wherever the interpolated shaft between
-    two aimed samples would pass the centre farther than tol_mm."""
+    two aimed samples would pass the centre farther than tol_mm from where the aim puts it.
+    `bend`: the tool's bent point (BEND_MM), whose shaft's axis is aimed."""
     def sample_at(a, b, u):
         s = {"t": a["t"] + u * (b["t"] - a["t"]), "pos": lerp(a["pos"], b["pos"], u),
              "quat": slerp(a["quat"], b["quat"], u)}
@@ -130,7 +158,7 @@ def pivot_track(track, centre, axis, inside, tol_mm=0.01, max_depth=8):
 
     def aim(s):
         if inside(s["pos"]):
-            s["quat"] = aimed(s["pos"], s["quat"], centre, axis)
+            s["quat"] = aimed(s["pos"], s["quat"], centre, axis, bend)
         return s
 
     def worst(a, b):
@@ -138,7 +166,11 @@ def pivot_track(track, centre, axis, inside, tol_mm=0.01, max_depth=8):
         for k in range(1, 8):
             s = sample_at(a, b, k / 8)
             if inside(s["pos"]) and dot(sub(centre, s["pos"]), mul(-1, axis)) > 1e-6:
-                e = max(e, offset_from(s["pos"], shaft_of(s["quat"]), centre))
+                off = axis_offset(s["pos"], s["quat"], centre, bend)
+                if bend:  # where the aim itself cannot reach the centre yet, from where it does
+                    off = abs(off - axis_offset(s["pos"], aimed(s["pos"], s["quat"], centre, axis,
+                                                                 bend), centre, bend))
+                e = max(e, off)
         return e
 
     def fill(a, b, depth):

@@ -61,7 +61,8 @@ void init_sides(HapticSlot& s, HapticScratch& sc) {
 
 // One tick of one model: contacts, nodes, proxy, force.
 void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& dev_vel,
-               const Vec3& shaft, const HapticSettings& st, uint64_t& resets) {
+               const Vec3& shaft, const Vec3& axis_offset, const HapticSettings& st,
+               uint64_t& resets) {
   const HapticTool& m = s.model;
   s.active = 0, s.penetration_mm = 0, s.lens_depth_mm = 0, s.sphere_depth_mm = 0, s.iterations = 0;
   const double dt = st.dt_s;
@@ -96,7 +97,7 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
     p = node(s, grasped);
     s.active |= kTermGrasp;
     Planes port;
-    const uint32_t n = detail::add_port_planes(m, dev, shaft, r, port, 0);
+    const uint32_t n = detail::add_port_planes(m, dev, shaft, axis_offset, r, port, 0);
     if (n > 0) {
       port_force = kc * (solve_proxy(dev, dev, kc, r, port, n) - dev);
       if (port_force.squaredNorm() > 0) s.active |= kTermPort;
@@ -118,7 +119,7 @@ void tick_slot(HapticSlot& s, HapticScratch& sc, const Vec3& dev, const Vec3& de
     };
     build(dev);
     const uint32_t first_port = np;
-    np = detail::add_port_planes(m, dev, shaft, r, planes, np);
+    np = detail::add_port_planes(m, dev, shaft, axis_offset, r, planes, np);
     const uint32_t first_sphere = np;
     if (m.sphere_count > 0) {
       Planes rigid;
@@ -295,10 +296,19 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
 HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
                         const Vec3& device_vel_mm_s, const Vec3& device_shaft_dir,
                         const HapticSettings& settings, HapticToolState& state) {
+  return haptic_tick(model, device_pos_mm, device_vel_mm_s, device_shaft_dir, Vec3::Zero(),
+                     settings, state);
+}
+
+HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
+                        const Vec3& device_vel_mm_s, const Vec3& device_shaft_dir,
+                        const Vec3& device_axis_offset_mm, const HapticSettings& settings,
+                        HapticToolState& state) {
   HapticForce out;
   ++state.ticks;
   // A shaft that is not a direction (no orientation, or a bad sample) only loses the port.
   const Vec3 shaft = finite(device_shaft_dir) ? device_shaft_dir : Vec3::Zero();
+  const Vec3 axis_offset = finite(device_axis_offset_mm) ? device_axis_offset_mm : Vec3::Zero();
   if (!finite(device_pos_mm) || !finite(device_vel_mm_s)) {
     ++state.inputs_rejected;
     out.input_rejected = true;
@@ -315,7 +325,8 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
   HapticSlot& cur = state.slot[state.newest];
   HapticSlot& old = state.slot[state.newest ^ 1];
   const Vec3 cur_before = cur.force, old_before = old.force;
-  tick_slot(cur, state.scratch, device_pos_mm, device_vel_mm_s, shaft, settings, state.slot_resets);
+  tick_slot(cur, state.scratch, device_pos_mm, device_vel_mm_s, shaft, axis_offset, settings,
+            state.slot_resets);
   Vec3 f = cur.force;
   out.active = cur.active;
   double natural = (cur.force - cur_before).norm();  // the model's own change this tick
@@ -323,7 +334,7 @@ HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
   if (old.live && (state.blending || state.slewing)) {
     // The settled model keeps ticking until the output has caught up: its own change is the
     // natural rate the slew bound allows on top (the new model's first ticks are not).
-    tick_slot(old, state.scratch, device_pos_mm, device_vel_mm_s, shaft, settings,
+    tick_slot(old, state.scratch, device_pos_mm, device_vel_mm_s, shaft, axis_offset, settings,
               state.slot_resets);
     natural = (old.force - old_before).norm();
   }

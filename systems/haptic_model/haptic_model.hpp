@@ -197,6 +197,13 @@ void adopt_model(const HapticTool& model, HapticToolState& state, const HapticSe
 HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
                         const Vec3& device_vel_mm_s, const Vec3& device_shaft_dir,
                         const HapticSettings& settings, HapticToolState& state);
+// The same for a tool whose shaft's axis runs beside its tip (a bent point): the port holds the
+// line through device_pos_mm + device_axis_offset_mm (the tool's bend turned with the device,
+// engine/io/tool_shape) along the shaft, the drawn shaft, as the scene's ports do.
+HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
+                        const Vec3& device_vel_mm_s, const Vec3& device_shaft_dir,
+                        const Vec3& device_axis_offset_mm, const HapticSettings& settings,
+                        HapticToolState& state);
 // The same without the device's orientation (no port term).
 HapticForce haptic_tick(const HapticTool& model, const Vec3& device_pos_mm,
                         const Vec3& device_vel_mm_s, const HapticSettings& settings,

@@ -14,8 +14,8 @@
 
 namespace phaco::haptic_model::detail {
 
-uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& shaft, double r,
-                         Planes& planes, uint32_t count) {
+uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& shaft,
+                         const Vec3& axis_offset, double r, Planes& planes, uint32_t count) {
   const double k = m.port_stiffness_mn_per_mm, len = shaft.norm();
   if (!m.port_present || !(k > 0) || !(len > 1e-9) || !std::isfinite(len)) return count;
   const Vec3 d = shaft / len;
@@ -23,11 +23,14 @@ uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& sh
   const Vec3 a = Vec3(m.port_axis[0], m.port_axis[1], m.port_axis[2]).normalized();
   const Vec3 ew = Vec3(m.port_width_dir[0], m.port_width_dir[1], m.port_width_dir[2]).normalized();
   const Vec3 eh = a.cross(ew);
+  // The tunnel holds the shaft's axis, through P + axis_offset (a bent point): the planes on P are
+  // those of a centre moved back by the offset.
+  const Vec3 ca = c - axis_offset;
   // In the port while the tip is past the outer opening and the centre is behind it along the
   // shaft (systems/tool_eye engaged_port's rule); the springs fade in from the tip at the centre
   // to the tip half a tunnel past it, so neither entering nor leaving is a step.
   const double half_length = std::max(1e-3, 0.5 * double(m.port_tunnel_length_mm));
-  const double behind = (c - device).dot(d), depth = (device - c).dot(a);
+  const double behind = (ca - device).dot(d), depth = (device - c).dot(a);
   const double weight = std::clamp(behind / half_length, 0.0, 1.0) *
                         std::clamp((depth + half_length) / half_length, 0.0, 1.0);
   if (!(weight > 0)) return count;
@@ -41,7 +44,7 @@ uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& sh
     for (const double side : {1.0, -1.0}) {
       if (count >= kMaxPlanes) return count;
       // pen = r − side·n·(P − point) = side·n·(c − P) − free/|g|: the offset past the free band.
-      planes[count++] = {side * n, c - side * (free / gn + r) * n, weight * k * gn * gn};
+      planes[count++] = {side * n, ca - side * (free / gn + r) * n, weight * k * gn * gn};
     }
   }
   return count;

@@ -52,8 +52,10 @@ uint32_t add_sphere_planes(const HapticTool& m, const Vec3& outside, const Vec3&
 // springs fade in as the device's tip goes from the port's centre to half a tunnel past it, so
 // entering or leaving the port is continuous. Returns the new count (unchanged: no port, no
 // shaft, or the tip outside the tunnel).
-uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& shaft, double r,
-                         Planes& planes, uint32_t count);
+// `axis_offset`: the device's tip → its shaft's axis (a bent point, turned with the device), which
+// the tunnel holds; zero for a straight tool.
+uint32_t add_port_planes(const HapticTool& m, const Vec3& device, const Vec3& shaft,
+                         const Vec3& axis_offset, double r, Planes& planes, uint32_t count);
 
 // A held fragment's load on the tip this tick (components/held_fragment.hpp): advances the
 // fragment (backward Euler, unconditionally stable at any mass) hanging from the proxy P moving at

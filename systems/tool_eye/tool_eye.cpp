@@ -115,14 +115,18 @@ double evaluate(const Problem& pb, const Unknowns& x, Matrix* h, Vector* g,
     double& te = local[i].energy;
     const Vec3 p = hand.tip_mm + x.u[i];
     const Vec3 d = (x.turn[i] * (hand.shaft / shaft_len)).normalized();
+    // The shaft's axis passes through pa, beside the tip by the bent point turned with the tool.
+    const bool bent = !hand.axis_offset_mm.isZero();
+    const Vec3 o = bent ? Vec3(x.turn[i] * hand.axis_offset_mm) : Vec3::Zero();
+    const Vec3 pa = bent ? Vec3(p + o) : p;
     const Vec3 rc = rot * (port.centre_mm - gc);  // port centre from the globe centre
     const Vec3 c = gc + rc;
     const Vec3 a = rot * port.axis;
     const Vec3 ew = rot * port.width_dir;
     const Vec3 eh = a.cross(ew);
 
-    // Tunnel, translational: the shaft line's offset from the port centre.
-    const Vec3 w = c - p;
+    // Tunnel, translational: the shaft's axis's offset from the port centre.
+    const Vec3 w = c - pa;
     const double s = w.dot(d);
     const Vec3 delta = w - s * d;
     const double half_width = 0.5 * port.width_mm;
@@ -136,6 +140,7 @@ double evaluate(const Problem& pb, const Unknowns& x, Matrix* h, Vector* g,
       Row j = Row::Zero();
       j.segment<3>(ui) = -ge;
       j.segment<3>(ei) = -d.dot(e) * d.cross(w) - s * d.cross(e);
+      if (bent) j.segment<3>(ei) -= o.cross(ge);  // the axis point swings about the tip too
       j.segment<3>(kGlobe) = rc.cross(ge) + e.cross(delta);
       add_spring(k.tunnel_mn_mm, r, j, energy, h, g, te);
       local[i].port_force += -k.tunnel_mn_mm * r * ge;
@@ -217,9 +222,11 @@ Vec3 rotation_vector(const Quat& q_in) {
 }
 
 int engaged_port(std::span<const EyePort> ports, const Quat& globe_rotation,
-                 const Vec3& globe_centre, const Vec3& tip_mm, const Vec3& shaft, int current) {
+                 const Vec3& globe_centre, const Vec3& tip_mm, const Vec3& shaft, int current,
+                 const Vec3& axis_offset_mm) {
   const double len = shaft.norm();
   if (!(len > 1e-12) || !finite(tip_mm) || !std::isfinite(len)) return -1;
+  const Vec3 on_axis = finite(axis_offset_mm) ? Vec3(tip_mm + axis_offset_mm) : tip_mm;
   const Vec3 d = shaft / len;
   const Eigen::Matrix3d rot = globe_rotation.normalized().toRotationMatrix();
   int best = -1;
@@ -229,8 +236,8 @@ int engaged_port(std::span<const EyePort> ports, const Quat& globe_rotation,
     const Vec3 c = globe_centre + rot * (port.centre_mm - globe_centre);
     const Vec3 a = rot * port.axis;
     const double depth = (tip_mm - c).dot(a);  // the tip's way along the tunnel
-    const double s = (c - tip_mm).dot(d);      // where the shaft passes the centre
-    const double offset = ((c - tip_mm) - s * d).norm();
+    const double s = (c - on_axis).dot(d);     // where the shaft passes the centre
+    const double offset = ((c - on_axis) - s * d).norm();
     if (static_cast<int>(j) == current) {
       // Held until the tip is back out of the tunnel.
       if (depth > -0.5 * port.tunnel_length_mm && s > 0.0) return current;

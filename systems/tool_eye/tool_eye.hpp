@@ -20,7 +20,8 @@
 //                                                         depth measured radially from its centre
 //     + ½k_g|θ|²                                          the muscles (isotropic)
 //
-// δ is the shaft line's offset from the (rotated) port centre at its closest point, split along
+// δ is the shaft's axis's offset from the (rotated) port centre at its closest point (the axis
+// runs beside the tip by a bent point: HandPose::axis_offset_mm), split along
 // the slit's width direction w and its through direction h = axis × w. Only a tool engaged in a
 // port (engaged_port) has tunnel, cornea and lens springs: a tool outside every port is free.
 //
@@ -74,6 +75,10 @@ struct HandPose {
   Vec3 shaft = Vec3::UnitZ();  // tip → handle
   int port = -1;               // engaged_port's answer; −1: free
   bool lens_spring = true;     // false for a tool whose work is inside the lens (probe, chopper)
+  // Tip → the shaft's axis at the hand's pose, mm, ⟂ shaft (a bent point: the cystotome's,
+  // the chopper's; engine/io/tool_shape). The tunnel holds that line, the drawn shaft, and it
+  // turns with the tool about the tip. Zero for a straight tool.
+  Vec3 axis_offset_mm = Vec3::Zero();
 };
 
 struct SolverOptions {
@@ -86,11 +91,13 @@ struct SolverOptions {
 };
 
 // Which port the tool is in: the tip past the port's outer opening, the shaft heading out of the
-// eye, and the shaft line within a port width of its centre (nearest wins). Once in a port the
-// tool stays in it until the tip is back out of the tunnel (pushing hard does not free it).
-// −1 for a tool outside every port, or a non-finite or zero shaft.
+// eye, and the shaft's axis (through tip + axis_offset, HandPose) within a port width of its
+// centre (nearest wins). Once in a port the tool stays in it until the tip is back out of the
+// tunnel (pushing hard does not free it). −1 for a tool outside every port, or a non-finite or
+// zero shaft.
 int engaged_port(std::span<const EyePort> ports, const Quat& globe_rotation,
-                 const Vec3& globe_centre, const Vec3& tip_mm, const Vec3& shaft, int current);
+                 const Vec3& globe_centre, const Vec3& tip_mm, const Vec3& shaft, int current,
+                 const Vec3& axis_offset_mm = Vec3::Zero());
 
 // Minimises E from `state` (the last frame's: warm start) and writes the equilibrium into it.
 // Hands beyond kMaxPortTools are ignored. Never throws, never allocates.

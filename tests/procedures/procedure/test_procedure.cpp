@@ -15,6 +15,7 @@
 #include "components/body.hpp"
 #include "components/tool.hpp"
 #include "engine/core/error.hpp"
+#include "engine/io/tool_shape.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/procedure/procedure_run.hpp"
 #include "procedures/scene/drill_metrics.hpp"
@@ -81,11 +82,13 @@ TEST(Procedure, TheExpertRunsEndToEndAndEachStepScoresAsItsDrillOnTheCarriedEye)
         if (scene->world.at<Tool>(e).hand != Hand::Right) continue;
         if (const PortsRecord* ports = ports_record(*scene); ports && i < kMaxPortTools)
           main_port_force.back() = std::max(main_port_force.back(), ports->force_mn[i]);
-        // The main-port hand's track keeps its tip and aims its shaft through the cut port.
+        // The main-port hand's track keeps its tip and aims its shaft through the cut port: the
+        // drawn shaft's axis, beside the tip by the cystotome's bent point (engine/io/tool_shape).
         if (!pivot || (pose.pos - pivot->to.centre_mm).dot(pivot->to.axis) < 1.0) continue;
-        const Vec3 shaft = pose.quat.normalized() * Vec3::UnitZ();
-        const Vec3 d = pivot->to.centre_mm - pose.pos;
-        worst_off_port = std::max(worst_off_port, (d - d.dot(shaft) * shaft).norm());
+        const ShaftAxis axis = shaft_axis(pose, scene->world.at<Tool>(e).kind);
+        const Vec3 d = pivot->to.centre_mm - axis.point;
+        worst_off_port =
+            std::max(worst_off_port, (d - d.dot(axis.direction) * axis.direction).norm());
         ++pivoted_frames;
       }
     }

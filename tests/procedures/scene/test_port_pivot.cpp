@@ -1,12 +1,14 @@
 // A position-only input pivoting in its port (procedures/scene/port_pivot, issue 20 item 2): the
 // pose function aims the shaft through the port's centre once the tip is in, blends before, and
-// never jumps; and in the sculpting scene under "constrain" the shown shaft passes through the
-// main port's centre while the tip sweeps across the lens.
+// never jumps, for a bent tool its shaft's axis beside the tip; and in the sculpting scene under
+// "constrain" the shown shaft passes through the main port's centre while the tip sweeps across the
+// lens.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "components/tool.hpp"
+#include "engine/io/tool_shape.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/scene/port_pivot.hpp"
 #include "procedures/scene/scene.hpp"
@@ -34,7 +36,7 @@ TEST(PortPivot, TheShaftRunsThroughThePortCentreOnceTheTipIsIn) {
   // Tips across the anterior chamber, all well past the port.
   for (const Vec3& tip : {Vec3(1.5, -1.0, 1.5), Vec3(-1.0, 1.0, 1.2), Vec3(0.0, 0.0, 0.5)}) {
     hand.pos = tip;
-    const ToolPose p = pivot_in_port(hand, port);
+    const ToolPose p = pivot_in_port(hand, port, ToolKind::PhacoProbe);
     const Vec3 shaft = p.quat * Vec3::UnitZ();
     EXPECT_LT(off_line(tip, shaft, port.centre_mm), 1e-9);
     EXPECT_GT(shaft.dot(port.centre_mm - tip), 0) << "tip → handle: the port is behind the tip";
@@ -44,17 +46,54 @@ TEST(PortPivot, TheShaftRunsThroughThePortCentreOnceTheTipIsIn) {
   }
   // Outside the eye (before the port's centre) the orientation is the hand's.
   hand.pos = port.centre_mm - 2.0 * port.axis;
-  EXPECT_TRUE(pivot_in_port(hand, port).quat.isApprox(hand.quat.normalized(), 1e-12));
+  EXPECT_TRUE(
+      pivot_in_port(hand, port, ToolKind::PhacoProbe).quat.isApprox(hand.quat.normalized(), 1e-12));
   // Going in along the axis the orientation turns continuously: no step above a small angle.
   Quat last = hand.quat;
   double worst = 0;
   for (int i = 0; i <= 400; ++i) {
     hand.pos = port.centre_mm + (-1.0 + 0.01 * i) * port.axis + Vec3(0, 0, -0.003 * i);
-    const Quat q = pivot_in_port(hand, port).quat;
+    const Quat q = pivot_in_port(hand, port, ToolKind::PhacoProbe).quat;
     worst = std::max(worst, q.angularDistance(last));
     last = q;
   }
   EXPECT_LT(worst, 0.05) << "rad per 0.01 mm step";
+}
+
+// A bent point (engine/io/tool_shape): it is the shaft's axis, beside the tip, that runs through
+// the centre, the tip's line missing it by up to the bend; the pivot begins a bend deeper than a
+// straight tool's and still never jumps.
+TEST(PortPivot, ABentToolsShaftAxisRunsThroughThePortCentre) {
+  const EyePort port = main_port();
+  for (const ToolKind kind : {ToolKind::Cystotome, ToolKind::Chopper, ToolKind::Hook}) {
+    const double bend = shaft_offset_local(kind).norm();
+    ASSERT_GT(bend, 0.0);
+    ToolPose hand;
+    hand.quat = Quat(Eigen::AngleAxisd(1.2, Vec3::UnitY()));
+    for (const Vec3& tip : {Vec3(1.5, -1.0, 1.5), Vec3(-1.0, 1.0, 1.2), Vec3(0.0, 0.0, 0.5)}) {
+      hand.pos = tip;
+      const ToolPose p = pivot_in_port(hand, port, kind);
+      const ShaftAxis axis = shaft_axis(p, kind);
+      EXPECT_LT(off_line(axis.point, axis.direction, port.centre_mm), 1e-9) << to_string(kind);
+      EXPECT_GT(axis.direction.dot(port.centre_mm - tip), 0);
+      // The old pivot, about the tip's line, puts the drawn shaft the bend's sine off the centre.
+      const ToolPose straight = pivot_in_port(hand, port, ToolKind::PhacoProbe);
+      const ShaftAxis old_axis = shaft_axis(straight, kind);
+      EXPECT_GT(off_line(old_axis.point, old_axis.direction, port.centre_mm), 0.9 * bend);
+    }
+    // Just past the centre, nearer than the bend, the orientation is still the hand's.
+    hand.pos = port.centre_mm + 0.9 * bend * port.axis;
+    EXPECT_TRUE(pivot_in_port(hand, port, kind).quat.isApprox(hand.quat.normalized(), 1e-12));
+    Quat last = hand.quat;
+    double worst = 0;
+    for (int i = 0; i <= 500; ++i) {
+      hand.pos = port.centre_mm + (-1.0 + 0.01 * i) * port.axis + Vec3(0, 0, -0.003 * i);
+      const Quat q = pivot_in_port(hand, port, kind).quat;
+      worst = std::max(worst, q.angularDistance(last));
+      last = q;
+    }
+    EXPECT_LT(worst, 0.05) << to_string(kind) << ": rad per 0.01 mm step";
+  }
 }
 
 // The tip sweeps across the lens, the shaft given by the pose function (what the desktop input
@@ -75,7 +114,7 @@ TEST(PortPivot, UnderConstrainTheShownShaftPassesThroughThePortWhileTheTipMoves)
       TrackSample t;
       t.t = f * s.dt_s;
       t.pos = Vec3(2.0 - 3.5 * u, -1.2 + 2.4 * u, 1.8 - 0.4 * u);
-      t.quat = pivot_in_port({t.pos, start, 0, 0}, port).quat;
+      t.quat = pivot_in_port({t.pos, start, 0, 0}, port, ToolKind::PhacoProbe).quat;
       h.track.push_back(t);
     }
   }

@@ -1,10 +1,11 @@
 // The corneal port in the haptic thread's local model (systems/haptic_model/port_planes.cpp,
 // issue 20 item 2 "the haptic device feels the port"): a shaft through the port's centre feels
-// nothing; levering it through the slit, or across it past the slit's width, feels the tunnel's
-// spring in series with the coupling, perpendicular to the shaft; within the slit's width nothing;
-// the port fades in and out over the tunnel's inner half, so going in or out is continuous; a
-// device with no orientation feels no port; the port's force adds to a grasp's; and a port that
-// moves from model to model (the globe turning) keeps the force continuous within 5 % of its range.
+// nothing, a bent tool's shaft axis beside its tip included; levering it through the slit, or
+// across it past the slit's width, feels the tunnel's spring in series with the coupling,
+// perpendicular to the shaft; within the slit's width nothing; the port fades in and out over the
+// tunnel's inner half, so going in or out is continuous; a device with no orientation feels no
+// port; the port's force adds to a grasp's; and a port that moves from model to model (the globe
+// turning) keeps the force continuous within 5 % of its range.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -73,6 +74,25 @@ TEST(PortPlanes, AShaftThroughThePortsCentreFeelsNothing) {
     const Vec3 levered = Eigen::AngleAxisd(5 * kPi / 180, about) * shaft;
     EXPECT_GT(held_at(*port, tip, levered).force_mn.norm(), 5.0) << tip.transpose();
   }
+}
+
+// A bent point (the chopper's 1 mm, engine/io/tool_shape): the port holds the shaft's axis, the
+// line through the tip + the bend. With the axis through the centre nothing is felt although the
+// tip's line runs 1 mm through the slit; the same pose with no bend given (the line through the
+// tip) feels the tunnel's spring for that millimetre.
+TEST(PortPlanes, ABentToolsShaftAxisIsWhatThePortHolds) {
+  const auto port = port_tool();
+  const HapticSettings s;
+  const double ks = series(s.coupling_stiffness_mn_per_mm, kTunnel);
+  const Vec3 bend = -1.0 * kThrough;  // tip → the shaft's axis
+  const Vec3 tip = kCentre + 3.0 * kAxis - bend, shaft = -kAxis;
+  auto st = std::make_unique<HapticToolState>();
+  adopt_model(*port, *st, s);
+  HapticForce f;
+  for (int k = 0; k < 5; ++k) f = haptic_tick(*port, tip, Vec3::Zero(), shaft, bend, s, *st);
+  EXPECT_LT(f.force_mn.norm(), 1e-3);
+  const HapticForce line = held_at(*port, tip, shaft);
+  EXPECT_LT((line.force_mn - (-ks * 1.0) * kThrough).norm(), 1e-3 * ks);
 }
 
 TEST(PortPlanes, LeveringFeelsTheTunnelInSeriesWithTheCoupling) {

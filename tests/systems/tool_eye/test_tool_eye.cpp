@@ -152,6 +152,63 @@ TEST(ToolEye, ConjugateGradientEqualsADenseSolve) {
   EXPECT_GT(q.hessian.ldlt().vectorD().minCoeff(), 0.0);
 }
 
+// A bent point (the chopper's 1 mm, engine/io/tool_shape): the tunnel holds the shaft's axis,
+// beside the tip, not the line through the tip. With the axis on the tunnel's axis nothing is
+// loaded although the tip's line runs 1 mm through the slit; the same pose read as the line
+// through the tip, or the tip's line on the tunnel's axis with the shaft 1 mm through the slit,
+// press the tunnel; and the gradient of E, with the axis point turning about the tip, is the
+// energy's own (central differences).
+TEST(ToolEye, ABentPointsShaftAxisIsWhatTheTunnelHolds) {
+  const std::vector<EyePort> ports = {test_port()};
+  const EyePort& p = ports[0];
+  const EyeShape eye = test_eye();
+  const Vec3 eh = p.axis.cross(p.width_dir);
+  const Vec3 tip = p.centre_mm + 1.5 * p.axis + 1.0 * eh;  // 1 mm below the tunnel's axis
+  HandPose bent{tip, -p.axis, -1, false, -1.0 * eh};
+  bent.port = engaged_port(ports, Quat::Identity(), eye.globe_centre_mm, bent.tip_mm, bent.shaft,
+                           -1, bent.axis_offset_mm);
+  ASSERT_EQ(bent.port, 0);
+  GlobeState st;
+  solve(ports, eye, standard(), std::span<const HandPose>(&bent, 1), st, kTight);
+  EXPECT_LT(st.tools[0].port_force_mn.norm(), 1e-9);
+  EXPECT_LT(rotation_vector(st.rotation).norm(), 1e-12);
+
+  HandPose tip_line = bent;
+  tip_line.axis_offset_mm = Vec3::Zero();
+  GlobeState st_line;
+  solve(ports, eye, standard(), std::span<const HandPose>(&tip_line, 1), st_line, kTight);
+  EXPECT_GT(st_line.tools[0].port_force_mn.norm(), 50.0);
+
+  const HandPose off{p.centre_mm + 1.5 * p.axis, -p.axis, 0, false, 1.0 * eh};
+  GlobeState st_off;
+  solve(ports, eye, standard(), std::span<const HandPose>(&off, 1), st_off, kTight);
+  EXPECT_GT(st_off.tools[0].port_force_mn.norm(), 50.0);
+
+  // The gradient away from the equilibrium: tool and globe turned, the tip moved.
+  GlobeState x;
+  x.rotation = Quat(Eigen::AngleAxisd(0.02, Vec3(0.3, 1.0, 0.2).normalized()));
+  x.tools[0].tip_offset_mm = Vec3(0.05, -0.1, 0.03);
+  x.tools[0].shaft_turn = Quat(Eigen::AngleAxisd(0.1, Vec3(0.2, -0.5, 1.0).normalized()));
+  const Quadratic q = linearise(ports, eye, standard(), std::span<const HandPose>(&off, 1), x);
+  ASSERT_GT(q.gradient.norm(), 1.0);
+  const double h = 1e-6;
+  for (int i = 0; i < kUnknowns; ++i) {
+    if (i >= 6 && i < 12) continue;  // the second tool's slot: no hand
+    double e[2];
+    for (int side = 0; side < 2; ++side) {
+      GlobeState y = x;
+      const double step = side == 0 ? h : -h;
+      const Vec3 v = step * Vec3::Unit(i % 3);
+      const Quat turn(Eigen::AngleAxisd(std::abs(step), v.normalized()));
+      if (i < 3) y.tools[0].tip_offset_mm += v;
+      if (i >= 3 && i < 6) y.tools[0].shaft_turn = turn * x.tools[0].shaft_turn;
+      if (i >= 12) y.rotation = turn * x.rotation;
+      e[side] = linearise(ports, eye, standard(), std::span<const HandPose>(&off, 1), y).energy;
+    }
+    EXPECT_NEAR((e[0] - e[1]) / (2 * h), q.gradient[i], 1e-4 * q.gradient.norm()) << i;
+  }
+}
+
 TEST(ToolEye, TipPushedIntoTheLensEndsOutsideIt) {
   // The lens much stiffer than the hand, so the equilibrium is the constraint's.
   Stiffness k = standard();
