@@ -139,8 +139,9 @@ studies:
       experts and N scripted novices (default 30, quick 4) replayed with hand tremor (8-12 Hz,
       RMS transverse 35 / 59 um, axial 13 / 21 um), tempo and offset variations, each run to its
       end; score distributions, ROC AUC, the contrasting-groups cut-off (Thomsen 2015) and the
-      share of each cohort that passes it. Writes results/cohorts.*. Nucleus removal takes about
-      a minute per run.
+      share of each cohort that passes it. Writes results/cohorts.*; with --drill, the other
+      drills' rows are kept from the earlier results/cohorts.json, and the section names the run
+      each drill's rows come from. Nucleus removal takes about a minute per run.
   records [--pg ADMIN_URI]
       Issue 21, 1, 4 and 16 stations (processes, 200 records each) syncing to one PostgreSQL
       server at once: records per second, batch latency p50/p99/max, every record at the centre

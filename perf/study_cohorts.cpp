@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <ctime>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,7 +34,7 @@ const std::vector<std::string> kDrills = {"corneal_incision", "capsulorhexis", "
                                           "nucleus_removal"};
 
 struct DrillCohorts {
-  std::string drill;
+  std::string drill, run;  // run: which `phaco-perf cohorts` run the rows come from
   std::vector<double> experts, novices;
   int experts_failed = 0, novices_failed = 0;
   double auc = 0, cutoff = 0, experts_pass = 0, novices_pass = 0;
@@ -48,6 +51,49 @@ double mean(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
   return v.empty() ? std::nan("") : s / static_cast<double>(v.size());
+}
+
+void summarise(DrillCohorts& c) {
+  c.auc = roc_auc(c.experts, c.novices);
+  c.cutoff = contrasting_groups_cutoff(c.experts, c.novices);
+  c.experts_pass = share_at_or_above(c.experts, c.cutoff);
+  c.novices_pass = share_at_or_above(c.novices, c.cutoff);
+}
+
+// The rows of the drills not run this time, from the results of an earlier run (cohorts.json),
+// so that `--drill X` adds X's rows without dropping the others'. Rows written before the run
+// column existed say so.
+std::vector<DrillCohorts> kept_rows(const fs::path& json, const std::vector<std::string>& run,
+                                    Table& t) {
+  std::vector<DrillCohorts> kept;
+  std::ifstream in(json);
+  if (!in) return kept;
+  nlohmann::json rows;
+  try {
+    rows = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError("cohorts: cannot read the earlier results " + json.string() + ": " + e.what());
+  }
+  for (const std::string& drill : kDrills) {
+    if (std::find(run.begin(), run.end(), drill) != run.end()) continue;
+    DrillCohorts c;
+    c.drill = drill;
+    for (const auto& r : rows) {
+      if (r.value("drill", "") != drill) continue;
+      const bool expert = r.value("group", "") == "expert";
+      const double score = r.value("score", 0.0);
+      const bool failed = r.value("failed", 0.0) != 0.0;
+      c.run = r.value("run", std::string("an earlier run (before runs were recorded)"));
+      (expert ? c.experts : c.novices).push_back(score);
+      (expert ? c.experts_failed : c.novices_failed) += failed;
+      t.add({drill, r.value("group", ""), r.value("member", 0.0), r.value("script", ""),
+             r.value("seed", 0.0), score, failed ? 1.0 : 0.0, c.run});
+    }
+    if (c.experts.empty() || c.novices.empty()) continue;
+    summarise(c);
+    kept.push_back(std::move(c));
+  }
+  return kept;
 }
 
 }  // namespace
@@ -83,7 +129,12 @@ void run_cohorts(const StudyOptions& options) {
 
   Progress progress(static_cast<int>(drills.size()) * 2 * n + 1);
   Table t;
-  t.columns = {"drill", "group", "member", "script", "seed", "score", "failed"};
+  t.columns = {"drill", "group", "member", "script", "seed", "score", "failed", "run"};
+  // This run, as its section names it beside each drill's rows.
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  const std::string this_run = std::string(stamp) + ", --n " + std::to_string(n);
   std::vector<DrillCohorts> out;
   for (const std::string& drill : drills) {
     std::vector<fs::path> novices;
@@ -95,6 +146,7 @@ void run_cohorts(const StudyOptions& options) {
     const Scenario expert = load_scenario(scenarios / (drill + "_expert.json"));
     DrillCohorts c;
     c.drill = drill;
+    c.run = this_run;
     // Every member, experts then novices; run two at a time (each scene on one thread), the
     // first alone so the meshes are cached before two scenes read them.
     struct Member {
@@ -144,15 +196,19 @@ void run_cohorts(const StudyOptions& options) {
       (mb.group == 0 ? c.experts : c.novices).push_back(mb.score);
       (mb.group == 0 ? c.experts_failed : c.novices_failed) += mb.failed;
       t.add({drill, std::string(mb.group == 0 ? "expert" : "novice"), double(mb.m),
-             mb.script.filename().string(), double(mb.seed), mb.score, mb.failed ? 1.0 : 0.0});
+             mb.script.filename().string(), double(mb.seed), mb.score, mb.failed ? 1.0 : 0.0,
+             this_run});
     }
-    c.auc = roc_auc(c.experts, c.novices);
-    c.cutoff = contrasting_groups_cutoff(c.experts, c.novices);
-    c.experts_pass = share_at_or_above(c.experts, c.cutoff);
-    c.novices_pass = share_at_or_above(c.novices, c.cutoff);
+    summarise(c);
     out.push_back(std::move(c));
   }
   progress.step("cohorts: writing");
+  // The other drills' rows stay as an earlier run left them; every drill in kDrills order.
+  for (DrillCohorts& c : kept_rows(dir / "cohorts.json", drills, t)) out.push_back(std::move(c));
+  std::sort(out.begin(), out.end(), [](const DrillCohorts& a, const DrillCohorts& b) {
+    return std::find(kDrills.begin(), kDrills.end(), a.drill) <
+           std::find(kDrills.begin(), kDrills.end(), b.drill);
+  });
   write_csv(t, dir / "cohorts.csv");
   write_json(t, dir / "cohorts.json");
 
@@ -185,10 +241,12 @@ void run_cohorts(const StudyOptions& options) {
   save_chart(chart, dir / "cohorts.png");
 
   std::string md = "## Cohorts: do the scores separate skill? (issue 20 item 4)\n\n";
-  md += "Measured by `phaco-perf cohorts --n " + std::to_string(n) + "`, " + load +
-        ". Per drill, " + std::to_string(n) + " scripted experts (the drill's expert script) and " +
-        std::to_string(n) +
-        " scripted novices (its novice scripts in turn), each replayed with hand tremor (per axis "
+  std::string command = "phaco-perf cohorts --n " + std::to_string(n);
+  if (drills.size() < kDrills.size())
+    for (const std::string& d : drills) command += " --drill " + d;
+  md += "Measured by `" + command + "` (" + this_run + "), " + load +
+        ". Per drill, N scripted experts (the drill's expert script) and N scripted novices (its "
+        "novice scripts in turn), each replayed with hand tremor (per axis "
         "a sinusoid at 8–12 Hz; RMS transverse 35 µm for experts and 59 µm for novices, axial 13 "
         "and 21 µm: FBG-forceps measurements on porcine eyes), a tempo factor (±5 % experts, ±15 "
         "% novices) and a constant offset of the hands (σ 0.05 mm and 0.15 mm per axis) "
@@ -199,25 +257,32 @@ void run_cohorts(const StudyOptions& options) {
         "scores respond to those defects under human-like noise, not how real novices score.\n\n";
   md +=
       "| drill | N per group | experts mean (min–max) | novices mean (min–max) | failed "
-      "(complication) E / N | ROC AUC | cut-off | experts passing | novices passing |\n"
-      "|---|---|---|---|---|---|---|---|---|\n";
+      "(complication) E / N | ROC AUC | cut-off | experts passing | novices passing | run |\n"
+      "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const DrillCohorts& c : out) {
     const auto [emin, emax] = std::minmax_element(c.experts.begin(), c.experts.end());
     const auto [nmin, nmax] = std::minmax_element(c.novices.begin(), c.novices.end());
-    md += "| " + c.drill + " | " + std::to_string(n) + " | " + fmt("%.1f", mean(c.experts)) + " (" +
-          fmt("%.1f", *emin) + "–" + fmt("%.1f", *emax) + ") | " + fmt("%.1f", mean(c.novices)) +
-          " (" + fmt("%.1f", *nmin) + "–" + fmt("%.1f", *nmax) + ") | " +
-          std::to_string(c.experts_failed) + " / " + std::to_string(c.novices_failed) + " | " +
-          fmt("%.3f", c.auc) + " | " + fmt("%.1f", c.cutoff) + " | " +
-          fmt("%.0f %%", 100 * c.experts_pass) + " | " + fmt("%.0f %%", 100 * c.novices_pass) +
-          " |\n";
+    md += "| " + c.drill + " | " + std::to_string(c.experts.size()) + " | " +
+          fmt("%.1f", mean(c.experts)) + " (" + fmt("%.1f", *emin) + "–" + fmt("%.1f", *emax) +
+          ") | " + fmt("%.1f", mean(c.novices)) + " (" + fmt("%.1f", *nmin) + "–" +
+          fmt("%.1f", *nmax) + ") | " + std::to_string(c.experts_failed) + " / " +
+          std::to_string(c.novices_failed) + " | " + fmt("%.3f", c.auc) + " | " +
+          fmt("%.1f", c.cutoff) + " | " + fmt("%.0f %%", 100 * c.experts_pass) + " | " +
+          fmt("%.0f %%", 100 * c.novices_pass) + " | " + c.run + " |\n";
   }
-  std::string skipped;
-  for (const std::string& d : kDrills)
-    if (std::find(drills.begin(), drills.end(), d) == drills.end())
-      skipped += (skipped.empty() ? "" : ", ") + d;
-  if (!skipped.empty())
-    md += "\nNot run this time (`--drill` chose the others): " + skipped + ".\n";
+  std::string kept, missing;
+  for (const std::string& d : kDrills) {
+    if (std::find(drills.begin(), drills.end(), d) != drills.end()) continue;
+    const bool has =
+        std::any_of(out.begin(), out.end(), [&](const DrillCohorts& c) { return c.drill == d; });
+    (has ? kept : missing) += ((has ? kept : missing).empty() ? "" : ", ") + d;
+  }
+  if (!kept.empty())
+    md +=
+        "\nNot run this time (`--drill` chose the others), their rows kept from the earlier run "
+        "named in the run column: " +
+        kept + ".\n";
+  if (!missing.empty()) md += "\nNot run, and no earlier rows: " + missing + ".\n";
   md += "\n![cohort scores](results/cohorts.png)\n\n";
   write_section(dir, "cohorts", md);
   progress.finish();

@@ -8,8 +8,9 @@ The drill starts with the nucleus grooved by a cross (data/drills/nucleus_remova
 guidance.trench_cross: one trench along x, one along y, 1.35 mm wide, 80 % deep). The expert:
   1. both tips into the x trench at x = -1.2, on its walls, pushed apart across it: the nucleus
      cracks into two halves along y = 0;
-  2. the same in the y trench of the -y half (y = -1.2), then of the +y half (y = +1.2, higher),
-     pushed apart at ten places across the trench, since the halves move once apart (crack()):
+  2. the same in the y trench of the -y half (at y = -1.2, then -0.8), then of the +y half
+     (y = +1.2, then +0.8; higher), pushed apart at ten places across the trench at each, since
+     the halves move once apart (crack()):
      four quadrants;
   3. for each quadrant: the probe into its inner corner with aspiration (pedal 2) until the port
      occludes and the vacuum holds the quadrant, then ultrasound (pedal 3) while the vacuum feeds it
@@ -84,10 +85,18 @@ def crack(mid, d, offsets, sep=(1.0, 1.6), z=None):
         both(0.3, at(o, 0.5 * sep[1]) + [zc], 1, at(o, -0.5 * sep[1]) + [zc])
     both(0.6, at(o, 0.5 * sep[1]) + [Z_ABOVE], 1, at(o, -0.5 * sep[1]) + [Z_ABOVE])
 
+Y_ROWS = (1.2, 0.8)
 ACROSS = [-0.8, -0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0]
 crack([-1.2, 0.0], [0.0, -1.0], [0.0], sep=(0.8, 1.4))  # along the x trench: two halves
-crack([0.0, -1.2], [1.0, 0.0], ACROSS)   # the -y half along the y trench
-crack([0.0, 1.2], [1.0, 0.0], ACROSS, z=0.1)  # the +y half, higher: its pieces sank
+# Each y crack is tried 1.2 mm from the centre, then 0.8 mm: once the halves part they sink and
+# tip toward the x crack, by how much depends on the lens's resolution (their centroids sit at
+# |y| = 0.57 mm at level 3, 1.2 mm at level 1), and at the tips' height the slice out at 1.2 mm
+# passes under the y trench's floor at level 3 while the one at 0.8 mm is closed at level 0 (+y
+# half). A blind hand tries both; once a half has cracked, the second row straddles the crack.
+for y in Y_ROWS:
+    crack([0.0, -y], [1.0, 0.0], ACROSS)   # the -y half along the y trench
+for y in Y_ROWS:
+    crack([0.0, y], [1.0, 0.0], ACROSS, z=0.1)  # the +y half, higher: its pieces sank
 
 chopper_park = [-1.0, 0.0, Z_ABOVE]
 occlude_pedal = 3 if args.wasteful else 2

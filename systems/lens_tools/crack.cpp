@@ -28,11 +28,10 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
   CrackPush out;
   const Vec3f p = probe_tip.cast<float>(), q = chopper_tip.cast<float>();
   const Vec3f m = 0.5f * (p + q);
-  // Nearest cells to each tip (the lowest id among equals) and to the midpoint, over fixed chunks
-  // merged in id order: the same cells as one walk in id order, for any thread count.
+  // Nearest cells to each tip (the lowest id among equals), over fixed chunks merged in id order:
+  // the same cells as one walk in id order, for any thread count.
   struct Scan {
     Nearest np, nq;
-    float gap2 = std::numeric_limits<float>::infinity();
   };
   const uint32_t n = static_cast<uint32_t>(c.x.size());
   const Scan scan = parallel_reduce_ordered(
@@ -42,31 +41,70 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
         for (uint32_t i = b; i < e; ++i) {
           if (!c.alive[i]) continue;
           const Vec3f x(c.x[i], c.y[i], c.z[i]);
-          const float dp = (x - p).squaredNorm(), dq = (x - q).squaredNorm(),
-                      dm = (x - m).squaredNorm();
+          const float dp = (x - p).squaredNorm(), dq = (x - q).squaredNorm();
           if (dp < s.np.d2) s.np = {i, dp};
           if (dq < s.nq.d2) s.nq = {i, dq};
-          s.gap2 = std::min(s.gap2, dm);
         }
         return s;
       },
       [](Scan a, const Scan& b) {
         if (b.np.d2 < a.np.d2) a.np = b.np;
         if (b.nq.d2 < a.nq.d2) a.nq = b.nq;
-        a.gap2 = std::min(a.gap2, b.gap2);
         return a;
       });
-  const Nearest np = scan.np, nq = scan.nq;
-  const float gap2 = scan.gap2;
-  const float contact2 = static_cast<float>(s.contact_radius_mm * s.contact_radius_mm);
-  const float gap_r2 = static_cast<float>(s.gap_radius_mm * s.gap_radius_mm);
-  const bool touching = np.cell != kNone && nq.cell != kNone && np.d2 <= contact2 &&
-                        nq.d2 <= contact2 && c.label[np.cell] == c.label[nq.cell];
   const double separation = (probe_tip - chopper_tip).norm();
-  if (!touching || gap2 < gap_r2 || separation <= 0) {
+  if (scan.np.cell == kNone || scan.nq.cell == kNone || separation <= 0) {
     state = CrackState{};
     return out;
   }
+  // The fragment pushed is the probe's or the chopper's: per candidate, the other tip's nearest
+  // cell of it and the nearest cell of it to the midpoint. Only its own cells bridge its trench: a
+  // piece of another fragment lying in the trench (a quadrant that slid in after an earlier crack,
+  // as the finer lenses' pieces do) holds nothing together.
+  const uint32_t fp = c.label[scan.np.cell], fq = c.label[scan.nq.cell];
+  struct Candidates {
+    Nearest q_on_fp, p_on_fq;
+    float gap_fp = std::numeric_limits<float>::infinity(),
+          gap_fq = std::numeric_limits<float>::infinity();
+  };
+  const Candidates cand = parallel_reduce_ordered(
+      0u, n, kGrain, Candidates{},
+      [&](uint32_t b, uint32_t e) {
+        Candidates s;
+        for (uint32_t i = b; i < e; ++i) {
+          if (!c.alive[i] || (c.label[i] != fp && c.label[i] != fq)) continue;
+          const Vec3f x(c.x[i], c.y[i], c.z[i]);
+          const float dm = (x - m).squaredNorm();
+          if (c.label[i] == fp) {
+            const float dq = (x - q).squaredNorm();
+            if (dq < s.q_on_fp.d2) s.q_on_fp = {i, dq};
+            s.gap_fp = std::min(s.gap_fp, dm);
+          }
+          if (c.label[i] == fq) {
+            const float dp = (x - p).squaredNorm();
+            if (dp < s.p_on_fq.d2) s.p_on_fq = {i, dp};
+            s.gap_fq = std::min(s.gap_fq, dm);
+          }
+        }
+        return s;
+      },
+      [](Candidates a, const Candidates& b) {
+        if (b.q_on_fp.d2 < a.q_on_fp.d2) a.q_on_fp = b.q_on_fp;
+        if (b.p_on_fq.d2 < a.p_on_fq.d2) a.p_on_fq = b.p_on_fq;
+        a.gap_fp = std::min(a.gap_fp, b.gap_fp);
+        a.gap_fq = std::min(a.gap_fq, b.gap_fq);
+        return a;
+      });
+  const float contact2 = static_cast<float>(s.contact_radius_mm * s.contact_radius_mm);
+  const float gap_r2 = static_cast<float>(s.gap_radius_mm * s.gap_radius_mm);
+  // Each tip touching the fragment, the trench (none of its cells) at their midpoint.
+  const bool on_fp = scan.np.d2 <= contact2 && cand.q_on_fp.d2 <= contact2 && cand.gap_fp >= gap_r2;
+  const bool on_fq = scan.nq.d2 <= contact2 && cand.p_on_fq.d2 <= contact2 && cand.gap_fq >= gap_r2;
+  if (!on_fp && !on_fq) {
+    state = CrackState{};
+    return out;
+  }
+  const Nearest np = on_fp ? scan.np : cand.p_on_fq, nq = on_fp ? cand.q_on_fp : scan.nq;
   const uint32_t fragment = c.label[np.cell];
   if (!state.engaged || state.fragment != fragment) {
     state.engaged = true;

@@ -16,8 +16,10 @@
 // lie on opposite sides of the plane through the tips' midpoint with normal n is broken (the
 // simplex system's break_link), and the fragment falls apart along the trench. The plane runs along
 // the trench because the tips push across it. A crack needs:
-//   - each tip touching the fragment: an alive cell of it within contact_radius_mm of the tip;
-//   - the trench between them: no alive cell within gap_radius_mm of their midpoint;
+//   - each tip touching the fragment: an alive cell of it within contact_radius_mm of the tip (the
+//     fragment is that of the cell nearest the probe, else that nearest the chopper);
+//   - the trench between them: no alive cell of that fragment within gap_radius_mm of their
+//     midpoint (a piece of another fragment lying in the trench does not bridge it);
 //   - the spread growing: d > 0 measured from the smallest separation while engaged (moving the
 //     tips together re-arms the spring; letting go of the fragment disengages).
 // Deterministic: the nearest cells are those of one pass in id order (a parallel scan over fixed

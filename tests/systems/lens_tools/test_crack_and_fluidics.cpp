@@ -67,6 +67,33 @@ TEST(Crack, NoPushWithoutATrenchBetweenTheTipsOrWithTwoFragments) {
   EXPECT_FALSE(push_apart(s.view(), Vec3(0.4, 5, 0), Vec3(-0.4, 5, 0), {}, state).engaged);
 }
 
+TEST(Crack, APieceOfAnotherFragmentLyingInTheTrenchDoesNotBridgeIt) {
+  // A crumb of another fragment (label 1) at the trench's centre, next to the tips' midpoint and
+  // nearer the chopper than its own wall: the walls are still one fragment with none of its cells
+  // between them, so the push engages and cracks as in an empty trench. (In the nucleus drill a
+  // quadrant that slid into the other half's trench after the second crack kept the third from
+  // engaging at level 3, where the pieces sink further.)
+  Slabs s;
+  for (const float pz : {-0.2f, 0.0f, 0.2f})
+    s.x.push_back(-0.1f), s.y.push_back(0), s.z.push_back(pz), s.hardness.push_back(0.5f),
+        s.alive.push_back(1), s.label.push_back(1);
+  CrackState state;
+  bool cracked = false;
+  for (int k = 0; k <= 30 && !cracked; ++k) {
+    const double spread = 0.01 * k;
+    const CrackPush p = push_apart(s.view(), Vec3(0.45 + spread / 2, 0, 0),
+                                   Vec3(-0.45 - spread / 2, 0, 0), {}, state);
+    ASSERT_TRUE(p.engaged) << k;
+    EXPECT_EQ(p.fragment, 0u);
+    cracked = p.crack;
+  }
+  EXPECT_TRUE(cracked);
+  // A cell of the walls' own fragment at the midpoint is material, not a trench.
+  s.label.back() = 0;
+  state = {};
+  EXPECT_FALSE(push_apart(s.view(), Vec3(0.45, 0, 0), Vec3(-0.45, 0, 0), {}, state).engaged);
+}
+
 TEST(Crack, LinksAcrossThePlaneAreThoseJoiningItsTwoSides) {
   // Five cells in a row along x, each linked to the next (face 0 forward, face 1 back).
   const std::vector<float> x{0, 1, 2, 3, 4}, y(5, 0.0f), z(5, 0.0f), h(5, 0.5f);
