@@ -132,7 +132,7 @@ Row measure(int level, eye::CapsuleLayout layout) {
 
 // The capsulorhexis demo in the scene at another level: the cut system's own cost per frame, and
 // the physics rebuild after each topology change (a pass over the whole capsule).
-struct SceneRow {
+struct CutSceneRow {
   int level = 0;
   double vertices = 0, frames = 0, changes = 0;
   double edit_ms_per_frame = 0, refresh_ms_mean = 0, refresh_ms_max = 0, frame_p50_ms = 0,
@@ -140,12 +140,12 @@ struct SceneRow {
   double closed = 0, diameter_mm = 0, circularity = 0;
 };
 
-SceneRow measure_scene(int level) {
+CutSceneRow measure_scene(int level) {
   Scenario s = load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) /
                              "data/scenarios/capsulorhexis_demo.json");
   s.eye.level = level;
   const RunReport r = run_scenario(s, SceneOptions{});
-  SceneRow row;
+  CutSceneRow row;
   row.level = level;
   for (const auto& [k, v] : r.elements)
     if (k == "capsule.particles") row.vertices = double(v);
@@ -187,7 +187,7 @@ void run_cut(const StudyOptions& options) {
       rows.push_back(best);
     }
   }
-  std::vector<SceneRow> scene_rows;
+  std::vector<CutSceneRow> scene_rows;
   for (int level = 1; level <= (options.quick ? 2 : 5); ++level) {
     progress.step("cut: demo scene at level " + std::to_string(level));
     scene_rows.push_back(measure_scene(level));
@@ -207,7 +207,7 @@ void run_cut(const StudyOptions& options) {
                 "opening_closed",
                 "opening_diameter_mm",
                 "opening_circularity"};
-  for (const SceneRow& r : scene_rows)
+  for (const CutSceneRow& r : scene_rows)
     st.add({double(r.level), r.vertices, r.frames, r.changes, r.edit_ms_per_frame,
             r.refresh_ms_mean, r.refresh_ms_max, r.frame_p50_ms, r.frame_p99_ms, r.closed,
             r.diameter_mm, r.circularity});
@@ -335,7 +335,7 @@ void run_cut(const StudyOptions& options) {
       "(ms) | frame p50 / "
       "p99 (ms) | opening closed | diameter (mm) | circularity "
       "|\n|---:|---:|---:|---:|---:|---:|:-:|---:|---:|\n";
-  for (const SceneRow& r : scene_rows) {
+  for (const CutSceneRow& r : scene_rows) {
     md += "| " + fmt("%.0f", r.level) + " | " + fmt("%.0f", r.vertices) + " | " +
           fmt("%.0f", r.changes) + " | " + fmt("%.3f", r.edit_ms_per_frame) + " | " +
           fmt("%.2f", r.refresh_ms_mean) + " / " + fmt("%.2f", r.refresh_ms_max) + " | " +
@@ -344,7 +344,7 @@ void run_cut(const StudyOptions& options) {
           fmt("%.3f", r.circularity) + " |\n";
   }
   std::vector<double> sv, sr;
-  for (const SceneRow& r : scene_rows) sv.push_back(r.vertices), sr.push_back(r.refresh_ms_mean);
+  for (const CutSceneRow& r : scene_rows) sv.push_back(r.vertices), sr.push_back(r.refresh_ms_mean);
   md += "\nRebuild cost against vertex count: power-law slope " +
         fmt("%.2f", fit_power_law(sv, sr).slope) + " (the non-local part of a topology change).\n";
   write_section(dir, "cut", md);

@@ -27,7 +27,7 @@
 namespace phaco::perf {
 namespace {
 
-struct SceneRow {
+struct LensSceneRow {
   int level = 0;
   double tets = 0, frames = 0, frame_p50_ms = 0, frame_p99_ms = 0, sculpt_p50_ms = 0,
          sculpt_p99_ms = 0;
@@ -35,12 +35,12 @@ struct SceneRow {
   double trenches = 0, width0 = 0, width1 = 0, depth0 = 0, depth1 = 0, crossing_deg = 0;
 };
 
-SceneRow measure_scene(int level) {
+LensSceneRow measure_scene(int level) {
   Scenario s = load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) /
                              "data/scenarios/phaco_sculpting_demo.json");
   s.eye.level = level;
   const RunReport r = run_scenario(s, SceneOptions{});
-  SceneRow row;
+  LensSceneRow row;
   row.level = level;
   row.frames = double(r.frames);
   row.frame_p50_ms = r.frame.p50_ms, row.frame_p99_ms = r.frame.p99_ms;
@@ -415,7 +415,7 @@ std::string tools_section(const std::vector<LensToolsRow>& rows,
   return md + "\n";
 }
 
-std::string scene_section(const std::vector<SceneRow>& rows, const std::filesystem::path& dir) {
+std::string scene_section(const std::vector<LensSceneRow>& rows, const std::filesystem::path& dir) {
   Table t;
   t.columns = {"level",
                "tets",
@@ -520,7 +520,7 @@ void run_lens(const StudyOptions& options) {
                                                options.quick ? 1 : 3);
 
   progress.step("lens: demo scene");
-  std::vector<SceneRow> scene_rows;
+  std::vector<LensSceneRow> scene_rows;
   for (int level : options.quick ? std::vector<int>{0, 1} : std::vector<int>{0, 1, 2, 3, 5}) {
     scene_rows.push_back(measure_scene(level));
   }

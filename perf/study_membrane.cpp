@@ -58,7 +58,7 @@ const CostRow* find(const std::vector<CostRow>& rows, const std::string& method,
   return nullptr;
 }
 
-std::string met(bool ok) {
+std::string met_bold(bool ok) {
   return ok ? "**met**" : "**missed**";
 }
 
@@ -334,14 +334,14 @@ void run_membrane(const StudyOptions& options) {
     if (const CostRow* r = find(costs, "plain step", level, 1)) {
       md += "| membrane step <= 8 ns/vertex/step, 1 core, " + std::to_string(r->vertices) +
             " vertices | " + fmt("%.2f", r->ns_per_vertex()) + " ns | " +
-            met(r->ns_per_vertex() <= 8) + " |\n";
+            met_bold(r->ns_per_vertex() <= 8) + " |\n";
     }
   }
   if (const CostRow* a = find(costs, "plain step", l128k, 1); a) {
     if (const CostRow* b = find(costs, "plain step", l128k, 2)) {
       const double s = a->s_per_step / b->s_per_step;
       md += "| >= 1.8x on 2 threads at " + std::to_string(a->vertices) + " vertices | " +
-            fmt("%.2f", s) + "x | " + met(s >= 1.8) + " |\n";
+            fmt("%.2f", s) + "x | " + met_bold(s >= 1.8) + " |\n";
     }
   }
   for (int level : {l8k, l128k}) {
@@ -351,7 +351,7 @@ void run_membrane(const StudyOptions& options) {
       const double ratio = bt->s_per_step / ours->s_per_step;
       md += "| >= 15x faster per step than btSoftBody, " + std::to_string(ours->vertices) +
             " vertices | " + fmt("%.1f", ratio) + "x (btSoftBody " +
-            fmt("%.0f", bt->ns_per_vertex()) + " ns/node) | " + met(ratio >= 15) + " |\n";
+            fmt("%.0f", bt->ns_per_vertex()) + " ns/node) | " + met_bold(ratio >= 15) + " |\n";
     }
   }
   if (active.size() >= 2) {
@@ -362,13 +362,13 @@ void run_membrane(const StudyOptions& options) {
           fmt("%.2f", ratio) + "x (" + fmt("%.1f", 1e6 * active.back().second.seconds_per_step) +
           " vs " + fmt("%.1f", 1e6 * active.front().second.seconds_per_step) + " us, " +
           std::to_string(active.back().second.active_particles) + " active particles) | " +
-          met(ratio <= 2) + " |\n";
+          met_bold(ratio <= 2) + " |\n";
   }
   md += "| hot tables <= 64 B/vertex | " + fmt("%.0f", hot_bytes_per_vertex()) +
         " B (particles x, y, z, vx, vy, vz, inv_mass: 7 floats + kind 1 B; forces 3 floats) | " +
-        met(hot_bytes_per_vertex() <= 64) + " |\n";
+        met_bold(hot_bytes_per_vertex() <= 64) + " |\n";
   md += "| hot tables <= 16 B/spring | " + fmt("%.0f", hot_bytes_per_spring()) +
-        " B (i, j, rest_length, stiffness) | " + met(hot_bytes_per_spring() <= 16) + " |\n\n";
+        " B (i, j, rest_length, stiffness) | " + met_bold(hot_bytes_per_spring() <= 16) + " |\n\n";
 
   // Bandwidth.
   md += "### The spring pass against the memory bandwidth\n\n";

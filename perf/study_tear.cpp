@@ -46,7 +46,7 @@ double number(const nlohmann::json& j, const std::string& key, double fallback =
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : fallback;
 }
 
-TearRun run(const fs::path& file, const std::string& difficulty, const fs::path& cache) {
+TearRun run_tear(const fs::path& file, const std::string& difficulty, const fs::path& cache) {
   Scenario s = load_scenario(file);
   if (!difficulty.empty()) s.difficulty = difficulty;
   SceneOptions o;
@@ -115,7 +115,7 @@ void run_tear(const StudyOptions& options) {
   std::vector<TearRun> runs;
   for (const auto& [file, level] : cases) {
     progress.step("tear: " + file.filename().string() + (level.empty() ? "" : ", " + level));
-    runs.push_back(run(file, level, cache));
+    runs.push_back(run_tear(file, level, cache));
   }
   progress.step("tear: writing");
   const TearRun& expert = runs.front();

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 constexpr double kTargetFps = 30.0;
 
-std::string met(bool ok) {
+std::string trainer_met(bool ok) {
   return ok ? "met" : "**missed**";
 }
 
@@ -78,10 +78,10 @@ std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const
           (r->render ? fmt("%.1f", s.value("frame_p50_ms", 0.0)) + " / " +
                            fmt("%.1f", s.value("frame_p99_ms", 0.0))
                      : std::string("—")) +
-          " | " + (r->render ? met(f >= kTargetFps) : std::string("—")) + " | " +
+          " | " + (r->render ? trainer_met(f >= kTargetFps) : std::string("—")) + " | " +
           fmt("%.1f", s.value("sim_rate_hz", 0.0)) + " | " +
           fmt("%.0f", s.value("haptic_period_p50_us", 0.0)) + " / " + fmt("%.0f", p99) + " | " +
-          met(p99 <= 1020.0) + " | " + fmt("%.0f", s.value("wall_s", 0.0)) + " |\n";
+          trainer_met(p99 <= 1020.0) + " | " + fmt("%.0f", s.value("wall_s", 0.0)) + " |\n";
   }
   md +=
       "\n| step | fps (render on) | wall s | simulated s | simulation Hz | haptic period p50 / "
@@ -177,8 +177,8 @@ void run_trainer_study(const StudyOptions& options) {
     const double f = on.value("fps", 0.0);
     md += "| " + runs[i].drill + " | " + on.value("renderer", std::string("?")) + " | " +
           fmt("%.1f", f) + " | " + fmt("%.1f", on.value("frame_p50_ms", 0.0)) + " / " +
-          fmt("%.1f", on.value("frame_p99_ms", 0.0)) + " | " + met(f >= kTargetFps) + " | " +
-          fmt("%.1f", on.value("sim_rate_hz", 0.0)) + " (" +
+          fmt("%.1f", on.value("frame_p99_ms", 0.0)) + " | " + trainer_met(f >= kTargetFps) +
+          " | " + fmt("%.1f", on.value("sim_rate_hz", 0.0)) + " (" +
           fmt("%.1f", off.value("sim_rate_hz", 0.0)) + ") | " +
           fmt("%.0f", on.value("haptic_period_p50_us", 0.0)) + " / " +
           fmt("%.0f", on.value("haptic_period_p99_us", 0.0)) + " (" +

@@ -7,6 +7,9 @@
 # loop, the lock-free handoff, the devices, the session) under ThreadSanitizer. TSan runs only those:
 # Debian's libtbb is not instrumented, so TSan would report oneTBB's own hand-offs as races, and
 # the haptic path is built without oneTBB.
+# All three builds are unity builds (PHACO_UNITY_BUILD, CMakeLists.txt: each target's files
+# compiled in batches of 8), which costs less CPU from scratch; the Release tests run on that
+# build. What every phase costs on 2 cores: docs/install.md ("What the CI run costs").
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 jobs="${PHACO_JOBS:-$(nproc)}"
@@ -28,7 +31,7 @@ if [ -n "$unformatted" ]; then
 fi
 
 build="$root/build/release"
-PHACO_BUILD_DIR="$build" "$root/scripts/build.sh"
+PHACO_BUILD_DIR="$build" "$root/scripts/build.sh" -DPHACO_UNITY_BUILD=ON
 # The xAPI validator the records tests run (issue 21): Learning Locker's, from npm, at the
 # version tests/tools/xapi/package-lock.json pins, installed into the build tree.
 mkdir -p "$build/xapi-validator"
@@ -67,7 +70,7 @@ if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   # time of -O2 -g on the Eigen-heavy files (shape_match's Horn solvers: 140 s at -O2 -g).
   cmake -S "$root" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHACO_SANITIZE=address \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-    -DPHACO_BUILD_BENCHMARKS=OFF >/dev/null
+    -DPHACO_BUILD_BENCHMARKS=OFF -DPHACO_UNITY_BUILD=ON >/dev/null
   # Only what the tests run (every test executable and the phaco CLI), not the perf harness.
   cmake --build "$asan" -j "$jobs" --target phaco_tests
   PHACO_CACHE_DIR="$asan/mesh-cache" ctest --test-dir "$asan" --output-on-failure -j "$jobs"
@@ -77,7 +80,7 @@ if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   tsan="$root/build/tsan"
   cmake -S "$root" -B "$tsan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHACO_SANITIZE=thread \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-    -DPHACO_BUILD_BENCHMARKS=OFF >/dev/null
+    -DPHACO_BUILD_BENCHMARKS=OFF -DPHACO_UNITY_BUILD=ON >/dev/null
   haptic_tests=(engine/haptics/test_haptic_loop engine/haptics_devices/test_haptics_devices
                 procedures/haptics/test_haptic_session)
   cmake --build "$tsan" -j "$jobs" --target "${haptic_tests[@]##*/}"

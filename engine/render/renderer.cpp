@@ -22,6 +22,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <utility>
 
@@ -33,11 +34,11 @@ namespace phaco::render {
 namespace {
 
 using Mat4f = Eigen::Matrix4f;
-constexpr double kPi = 3.14159265358979323846;
 
 // Illuminator: coaxial, tilted 20° toward 12 o'clock, so a shadow slides away from its instrument
 // by tan 20° ≈ 0.36 × the height above the tissue — the depth cue.
-const Vec3 kToLight = Vec3(0.0, std::sin(20.0 * kPi / 180), std::cos(20.0 * kPi / 180));
+const Vec3 kToLight =
+    Vec3(0.0, std::sin(20.0 * std::numbers::pi / 180), std::cos(20.0 * std::numbers::pi / 180));
 
 GLuint compile(GLenum type, const char* source, const char* name) {
   const GLuint shader = glCreateShader(type);
@@ -385,7 +386,8 @@ struct Renderer::Impl {
   void circle(const Eigen::Affine3d& to_world, const Vec3& centre, double r, double w,
               const Eigen::Vector4f& colour, int segments = 64) {
     for (int i = 0; i < segments; ++i) {
-      const double t0 = 2 * kPi * i / segments, t1 = 2 * kPi * (i + 1) / segments;
+      const double t0 = 2 * std::numbers::pi * i / segments,
+                   t1 = 2 * std::numbers::pi * (i + 1) / segments;
       ribbon(to_world * (centre + r * Vec3(std::cos(t0), std::sin(t0), 0)),
              to_world * (centre + r * Vec3(std::cos(t1), std::sin(t1), 0)), w, colour);
     }
@@ -420,7 +422,7 @@ struct Renderer::Impl {
       }
       if (g.trench_centre_mm && g.trench_arm_mm > 0)
         for (int k = 0; k < 2; ++k) {
-          const double a = (g.trench_first_angle_deg + 90.0 * k) * kPi / 180;
+          const double a = (g.trench_first_angle_deg + 90.0 * k) * std::numbers::pi / 180;
           const Vec3 d = g.trench_arm_mm * Vec3(std::cos(a), std::sin(a), 0);
           ribbon(eye * (*g.trench_centre_mm - d), eye * (*g.trench_centre_mm + d), w, green);
         }
@@ -459,8 +461,8 @@ struct Renderer::Impl {
       stats.triangles += slot.index_count / 3;
       ++stats.draw_calls;
       if (t.kind == ToolKind::Forceps) {
-        const double open =
-            (1.0 - std::clamp(t.grip, 0.0, 1.0)) * kForcepsOpenHalfAngleDeg * kPi / 180;
+        const double open = (1.0 - std::clamp(t.grip, 0.0, 1.0)) * kForcepsOpenHalfAngleDeg *
+                            std::numbers::pi / 180;
         for (int side : {-1, 1}) {
           Eigen::Affine3d jaw = pose;
           jaw.translate(Vec3(0, 0, kForcepsJawLength));

@@ -10,7 +10,7 @@ namespace phaco::report {
 
 namespace {
 
-constexpr const char* kStyle = R"(
+constexpr const char* kProcedureStyle = R"(
 body { font-family: "DejaVu Sans", Helvetica, Arial, sans-serif; color: #222; margin: 24px auto;
        max-width: 1100px; }
 table { border-collapse: collapse; margin: 12px 0; }
@@ -70,7 +70,7 @@ std::string procedure_html(const nlohmann::json& p) {
   std::string html =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<title>" +
-      escape_markup(name) + "</title>\n<style>" + kStyle +
+      escape_markup(name) + "</title>\n<style>" + kProcedureStyle +
       "</style>\n</head>\n<body>\n<h1>Procedure: " + escape_markup(name) + "</h1>\n";
   html += "<p>" + escape_markup(p.value("scenario", std::string())) + " &middot; " +
           escape_markup(p.value("date", std::string())) + "</p>\n";

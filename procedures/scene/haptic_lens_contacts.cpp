@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "components/held_fragment.hpp"
 #include "components/tets.hpp"
@@ -13,11 +14,8 @@
 namespace phaco {
 namespace {
 
-constexpr double kStandardHardness = 0.5;  // data/eye/standard_eye.json lens_model.nucleus_hardness
-constexpr double kPi = 3.14159265358979323846;
-
 double equal_volume_radius(double volume_mm3) {
-  return std::cbrt(3.0 * std::max(0.0, volume_mm3) / (4.0 * kPi));
+  return std::cbrt(3.0 * std::max(0.0, volume_mm3) / (4.0 * std::numbers::pi));
 }
 
 // The scratch's candidates, nearest first, into the tool's spheres (at most its capacity).

@@ -14,13 +14,13 @@
 #include "engine/core/error.hpp"
 #include "procedures/lens/nucleus_groove.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/density_units.hpp"
 #include "procedures/scene/method_settings.hpp"
 #include "procedures/scene/scene.hpp"
 
 namespace phaco {
 namespace {
 
-constexpr double kKgPerMm3PerKgPerM3 = 1e-9;
 constexpr double kRhexisRadiusMm = 2.6;
 constexpr double kGrooveWidthTipDiameters = 1.5;  // the sculpting drill's trench (DESIGN.md §6)
 constexpr double kGrooveDepthFraction = 0.8;

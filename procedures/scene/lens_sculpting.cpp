@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "components/from_mesh.hpp"
 #include "components/particles.hpp"
@@ -10,15 +11,11 @@
 #include "components/tool.hpp"
 #include "engine/core/error.hpp"
 #include "procedures/scene/capsule_physics.hpp"
+#include "procedures/scene/density_units.hpp"
 #include "procedures/scene/scene.hpp"
 
 namespace phaco {
 namespace {
-
-constexpr double kStandardHardness = 0.5;  // data/eye/standard_eye.json lens_model.nucleus_hardness
-
-constexpr double kKgPerMm3PerKgPerM3 = 1e-9;
-constexpr double kPi = 3.14159265358979323846;
 
 Vec3 rotate_z(const Vec3& p, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
@@ -198,7 +195,7 @@ nlohmann::json lens_sculpting_summary(Scene& scene) {
   j["sculpt_ms_mean"] = ls->sculpt_steps ? ls->sculpt_ms_total / double(ls->sculpt_steps) : 0.0;
   j["sculpt_ms_max"] = ls->sculpt_ms_max;
   j["max_tets_removed_per_step"] = ls->max_removed_per_step;
-  j["nucleus_rotation_deg"] = ls->rotation.angle_rad * 180.0 / kPi;
+  j["nucleus_rotation_deg"] = ls->rotation.angle_rad * 180.0 / std::numbers::pi;
   j["nucleus_inertia_kg_mm2"] = ls->rotation.inertia;
   j["nucleus_inertia0_kg_mm2"] = ls->rotation.inertia0;
   j["push_frames"] = ls->push_frames;
@@ -212,7 +209,7 @@ nlohmann::json lens_sculpting_summary(Scene& scene) {
                     {"depth_fraction", t.depth_fraction},
                     {"length_mm", t.length_mm},
                     {"volume_mm3", t.volume_mm3},
-                    {"axis_deg", std::atan2(t.axis.y(), t.axis.x()) * 180.0 / kPi},
+                    {"axis_deg", std::atan2(t.axis.y(), t.axis.x()) * 180.0 / std::numbers::pi},
                     {"strokes", t.strokes.size()}});
   }
   j["trenches"] = list;

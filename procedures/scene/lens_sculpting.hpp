@@ -33,6 +33,10 @@ namespace phaco {
 
 struct Scene;
 
+// The standard eye's nucleus hardness (data/eye/standard_eye.json lens_model.nucleus_hardness):
+// the hardness at which the lens's and the haptic contacts' settings hold as given.
+inline constexpr double kStandardHardness = 0.5;
+
 struct LensSculpting {
   TetTopology topology;
   sculpt::SculptState sculpt;

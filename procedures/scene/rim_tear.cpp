@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "components/particles.hpp"
@@ -16,8 +17,6 @@
 namespace phaco {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Vec3 at(const cut::CutMesh& m, uint32_t v) {
   return cut::particle_position(m.particles, v);
@@ -190,7 +189,7 @@ double membrane_angle_deg(const cut::CutMesh& m, uint32_t v) {
       if (const uint32_t c = cut::corner(m.triangles, t, k); c != v) d[n++] = at(m, c) - x;
     if (n == 2) sum += std::atan2(d[0].cross(d[1]).norm(), d[0].dot(d[1]));
   }
-  return sum * 180.0 / kPi;
+  return sum * 180.0 / std::numbers::pi;
 }
 
 RimTears make_rim_tears(const Scene& scene, double tear_resistance_mn) {

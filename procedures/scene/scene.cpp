@@ -20,6 +20,7 @@
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/cornea_cutting.hpp"
+#include "procedures/scene/density_units.hpp"
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/haptic_publish.hpp"
 #include "procedures/scene/lens_fragments.hpp"
@@ -33,8 +34,6 @@
 namespace phaco {
 
 namespace {
-
-constexpr double kKgPerMm3PerKgPerM3 = 1e-9;  // density kg/m³ → kg/mm³
 
 std::vector<std::string> to_strings(std::span<const char* const> names) {
   return {names.begin(), names.end()};

@@ -10,8 +10,8 @@ namespace phaco::cut {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kEndTol = 1e-12;    // exit parameter this close to 1 = the target itself
-constexpr double kStuckTol = 1e-12;  // exit parameter this close to 0 = no way forward
+constexpr double kEndTol = 1e-12;         // exit parameter this close to 1 = the target itself
+constexpr double kTraceStuckTol = 1e-12;  // exit parameter this close to 0 = no way forward
 
 // Where the walk stands: a face point of one triangle, a point on an edge, or a vertex.
 struct Location {
@@ -110,7 +110,8 @@ void trace_segment(const Particles& p, const Triangles& tr, const TriangleAdjace
       const double s = exit_parameter(wf, wt, exit);
       if (s > best_s) T = c, best_s = s, best_exit = exit, best_from = wf, best_target = wt;
     }
-    if (T == kInvalidIndex || best_s <= kStuckTol) return;  // e.g. heading off the rim at a vertex
+    if (T == kInvalidIndex || best_s <= kTraceStuckTol)
+      return;  // e.g. heading off the rim at a vertex
     out.triangles.push_back(T);
     if (best_s >= 1.0 - kEndTol) {
       out.complete = true;

@@ -51,7 +51,7 @@ void cross_edge(const Vec3& a, const Vec3& b, const Vec3& c, double r2, const Bl
   }
 }
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
+[[noreturn]] void fail_section(const std::string& field, const std::string& what) {
   throw std::invalid_argument("blade section: " + field + " " + what);
 }
 
@@ -69,9 +69,9 @@ double outline_signed_distance(const KeratomeShape& s, double u, double v) {
 BladeSection blade_section(const KeratomeBlade& blade, double sphere_centre_z,
                            double sphere_radius_mm) {
   const BladeFrame f = blade_frame(blade);
-  if (!std::isfinite(sphere_centre_z)) fail("sphere_centre_z", "is not finite");
+  if (!std::isfinite(sphere_centre_z)) fail_section("sphere_centre_z", "is not finite");
   if (!std::isfinite(sphere_radius_mm) || sphere_radius_mm <= 0.0)
-    fail("sphere_radius_mm", "must be a finite positive number (mm)");
+    fail_section("sphere_radius_mm", "must be a finite positive number (mm)");
   const KeratomeShape& shape = blade.shape;
   const Vec3 c(0.0, 0.0, sphere_centre_z);
   const double r2 = sphere_radius_mm * sphere_radius_mm;

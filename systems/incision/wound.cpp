@@ -11,7 +11,7 @@
 namespace phaco::incision {
 namespace {
 
-void require_positive(double v, const char* field) {
+void require_positive_radius(double v, const char* field) {
   if (!std::isfinite(v) || v <= 0.0)
     throw std::invalid_argument(std::string("cornea spheres: ") + field +
                                 " must be a finite positive number (mm)");
@@ -38,9 +38,9 @@ void check_spheres(const CorneaSpheres& s) {
     throw std::invalid_argument("cornea spheres: anterior_centre_z is not finite");
   if (!std::isfinite(s.posterior_centre_z))
     throw std::invalid_argument("cornea spheres: posterior_centre_z is not finite");
-  require_positive(s.anterior_radius_mm, "anterior_radius_mm");
-  require_positive(s.posterior_radius_mm, "posterior_radius_mm");
-  require_positive(s.limbus_radius_mm, "limbus_radius_mm");
+  require_positive_radius(s.anterior_radius_mm, "anterior_radius_mm");
+  require_positive_radius(s.posterior_radius_mm, "posterior_radius_mm");
+  require_positive_radius(s.limbus_radius_mm, "limbus_radius_mm");
 }
 
 CornealWound measure_wound(const BladeSection& outer, const BladeSection& inner,

@@ -10,7 +10,7 @@
 namespace phaco::lens_tools {
 
 namespace {
-constexpr uint32_t kGrain = 2048;
+constexpr uint32_t kCellGrain = 2048;
 }
 
 void aspirate(const CellSpans& cells, const Aspirator& a, const AspiratorSettings& s, double dt_s) {
@@ -20,7 +20,7 @@ void aspirate(const CellSpans& cells, const Aspirator& a, const AspiratorSetting
   const float dt = static_cast<float>(dt_s);
   if (!(radius > 0) || !(f0 > 0) || !(dt > 0)) return;
   const Vec3f port = a.port.cast<float>();
-  parallel_for(0, cells.size(), kGrain, [&](uint32_t b, uint32_t e, int) {
+  parallel_for(0, cells.size(), kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t i = b; i < e; ++i) {
       if (!cells.alive[i] || !(cells.mass[i] > 0)) continue;
       const float dx = port.x() - cells.x[i], dy = port.y() - cells.y[i],
@@ -80,7 +80,7 @@ void drag_with_hook(const CellSpans& cells, const Hook& h, const HookSettings& s
   float* __restrict vy = cells.vy.data();
   float* __restrict vz = cells.vz.data();
   const uint8_t* __restrict alive = cells.alive.data();
-  parallel_for(0, cells.size(), kGrain, [=](uint32_t b, uint32_t e, int) {
+  parallel_for(0, cells.size(), kCellGrain, [=](uint32_t b, uint32_t e, int) {
     // Branch-free (no unpredictable jump per cell): cells outside the cylinder, or dead, blend by
     // 0.
     for (uint32_t i = b; i < e; ++i) {
@@ -109,7 +109,7 @@ void integrate(const CellSpans& cells, const Medium& m, double dt_s) {
   float* __restrict vy = cells.vy.data();
   float* __restrict vz = cells.vz.data();
   const uint8_t* __restrict alive = cells.alive.data();
-  parallel_for(0, cells.size(), kGrain, [=](uint32_t b, uint32_t e, int) {
+  parallel_for(0, cells.size(), kCellGrain, [=](uint32_t b, uint32_t e, int) {
     // Branch-free (2× faster than skipping dead cells): a dead cell's step is scaled to zero, so it
     // only adds +0.
     for (uint32_t i = b; i < e; ++i) {

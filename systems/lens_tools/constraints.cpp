@@ -12,7 +12,7 @@ namespace phaco::lens_tools {
 
 namespace {
 
-constexpr uint32_t kGrain = 2048;
+constexpr uint32_t kConstraintGrain = 2048;
 constexpr double kSkinMm = 1e-5;  // ≫ float rounding at eye scale (≈ 5e-7 mm), ≪ any cell size
 constexpr double kFastMarginMm = 1e-4;  // float inside-test margin, ≫ its rounding error
 
@@ -151,10 +151,11 @@ void constrain(const CellSpans& cells, const EyeBounds& bounds, std::span<uint8_
                                               std::max(rhexis - kFastMarginMm, 0.0));
   const float rhexis_out2 = static_cast<float>((rhexis + kFastMarginMm) * (rhexis + kFastMarginMm));
   const bool has_rhexis = rhexis > 0;
-  // One block of at most kGrain cells (what a parallel_for chunk is; the loop below splits anyway).
+  // One block of at most kConstraintGrain cells (what a parallel_for chunk is; the loop below
+  // splits anyway).
   auto block = [&](uint32_t b, uint32_t e) {
     // Pass 1, branch-free: which cells might be outside (most are well inside every ball).
-    uint8_t suspect[kGrain];
+    uint8_t suspect[kConstraintGrain];
     const float* __restrict x = cells.x.data();
     const float* __restrict y = cells.y.data();
     const float* __restrict z = cells.z.data();
@@ -202,8 +203,8 @@ void constrain(const CellSpans& cells, const EyeBounds& bounds, std::span<uint8_
       if (flags) contact[i] = 1;
     }
   };
-  parallel_for(0, cells.size(), kGrain, [&](uint32_t b, uint32_t e, int) {
-    for (uint32_t s = b; s < e; s += kGrain) block(s, std::min(e, s + kGrain));
+  parallel_for(0, cells.size(), kConstraintGrain, [&](uint32_t b, uint32_t e, int) {
+    for (uint32_t s = b; s < e; s += kConstraintGrain) block(s, std::min(e, s + kConstraintGrain));
   });
 }
 

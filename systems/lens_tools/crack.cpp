@@ -13,7 +13,7 @@ namespace phaco::lens_tools {
 namespace {
 
 constexpr uint32_t kNone = 0xffffffffu;
-constexpr uint32_t kGrain = 8192;  // cells per chunk of the nearest-cell scan
+constexpr uint32_t kCrackGrain = 8192;  // cells per chunk of the nearest-cell scan
 
 struct Nearest {
   uint32_t cell = kNone;
@@ -35,7 +35,7 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
   };
   const uint32_t n = static_cast<uint32_t>(c.x.size());
   const Scan scan = parallel_reduce_ordered(
-      0u, n, kGrain, Scan{},
+      0u, n, kCrackGrain, Scan{},
       [&](uint32_t b, uint32_t e) {
         Scan s;
         for (uint32_t i = b; i < e; ++i) {

@@ -11,7 +11,7 @@ namespace phaco::lens_tools {
 
 namespace {
 constexpr double kSecondsPerMinute = 60.0;
-constexpr uint32_t kGrain = 8192;  // cells per chunk of the port scan
+constexpr uint32_t kPortGrain = 8192;  // cells per chunk of the port scan
 }  // namespace
 
 double vacuum_rise_time_s(const FluidicsSettings& s) {
@@ -45,7 +45,7 @@ PortCover port_cover(const CellSpans& cells, std::span<const float> volume,
   // The cells in the port (few), found in parallel over fixed chunks and listed in id order, then
   // summed in that order: the same sums as one walk.
   const std::vector<uint32_t> in_port = parallel_reduce_ordered(
-      0u, cells.size(), kGrain, std::vector<uint32_t>{},
+      0u, cells.size(), kPortGrain, std::vector<uint32_t>{},
       [&](uint32_t b, uint32_t e) {
         std::vector<uint32_t> ids;
         for (uint32_t i = b; i < e; ++i) {

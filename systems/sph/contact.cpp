@@ -14,7 +14,7 @@ namespace phaco::sph {
 
 namespace {
 
-constexpr uint32_t kGrain = 256;
+constexpr uint32_t kContactGrain = 256;
 constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the mixed-cell passes
 
 // ∫ u(1 − u²)² du = −(1 − u²)³/6, normalised by the peak u_p(1 − u_p²)², u_p = 1/√5; below
@@ -157,7 +157,7 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
     for (uint32_t s = 0; s < g.count; ++s) scratch.fragment_slot[s] = in.fragment[g.id[s]];
     std::fill(scratch.fragment_slot.begin() + g.count, scratch.fragment_slot.end(), 0u);
     twice = parallel_reduce_ordered(
-        0u, g.count, kGrain, uint64_t{0},
+        0u, g.count, kContactGrain, uint64_t{0},
         [&](uint32_t b, uint32_t e) {
           uint64_t pairs = 0;
           Candidates candidates(g);
@@ -176,7 +176,7 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
         [](uint64_t a, uint64_t b) { return a + b; });
   } else {
     twice = parallel_reduce_ordered(
-        0u, g.count, kGrain, uint64_t{0},
+        0u, g.count, kContactGrain, uint64_t{0},
         [&](uint32_t b, uint32_t e) {
           uint64_t pairs = 0;
           float sx = 0.0f, sy = 0.0f, sz = 0.0f;

@@ -18,7 +18,7 @@ using simd8::I8;
 using simd8::load8;
 using simd8::splat;
 
-constexpr uint32_t kGrain = 1024;
+constexpr uint32_t kNeighbourGrain = 1024;
 
 // Σ m_j (h² − r²)³ over the candidates [b, e) inside h, eight at a time into lane sums and counts
 // (candidate b + 8k + l goes to lane l, so a particle's sum does not depend on the chunking). The
@@ -83,7 +83,7 @@ void density_pass(const Grid& g, std::span<float> density, std::span<uint32_t> n
   assert(same_size(density, neighbours) && all_below(g.id, density.size()));
   const float norm = static_cast<float>(poly6_normalisation(g.h));
   if (g.order == CellOrder::UnsortedHash) {
-    parallel_for(0, g.count, kGrain, [&](uint32_t b, uint32_t e, int) {
+    parallel_for(0, g.count, kNeighbourGrain, [&](uint32_t b, uint32_t e, int) {
       for (uint32_t i = b; i < e; ++i) {
         float rho = g.m[i] * g.h2 * g.h2 * g.h2;  // self: r = 0
         uint32_t n = 0;
@@ -98,7 +98,7 @@ void density_pass(const Grid& g, std::span<float> density, std::span<uint32_t> n
     });
     return;
   }
-  parallel_for(0, g.count, kGrain, [&](uint32_t b, uint32_t e, int) {
+  parallel_for(0, g.count, kNeighbourGrain, [&](uint32_t b, uint32_t e, int) {
     density_chunk(g, b, e, norm, density.data(), neighbours.data());
   });
 }

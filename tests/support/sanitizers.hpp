@@ -2,7 +2,7 @@
 // Test sizes under AddressSanitizer. scripts/test.sh runs every test twice: in Release, at full
 // size, and under ASan+UBSan, which looks for memory errors on the same code paths and runs them
 // 5–20× slower. Fuzz loops there run a fraction of their cases, so CI stays well under its
-// 30-minute limit; the Release pass keeps the full counts.
+// 45-minute limit; the Release pass keeps the full counts.
 #include <algorithm>
 
 namespace phaco::test {

@@ -15,19 +15,25 @@
 // Each path starts from the same grooved lens and takes 16 steps (1,000 × 16 = 16,000 steps; a
 // path long enough for a crack, an occlusion and a hold, short enough for the suite: ~8 s of CPU
 // in Release). Deterministic: every draw is CounterRng(seed).uniform(path, k).
+// Under AddressSanitizer (scripts/test.sh's second pass, ~15x slower) the first fifth of the paths
+// runs, the same draws, to look for memory errors on the same code; the Release pass runs all
+// 1,000 (issue 19's target), which the static_assert below keeps.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "procedures/eye/eye_mesh.hpp"
 #include "procedures/lens/fragment_lens.hpp"
 #include "procedures/lens/nucleus_groove.hpp"
+#include "tests/support/sanitizers.hpp"
 
 namespace phaco::lens {
 namespace {
 
 constexpr double kDt = 1.0 / 120.0;
-constexpr int kPaths = 1000;
+constexpr int kPaths = test::asan_scaled(1000, 5);
+static_assert(test::kUnderAsan || kPaths == 1000, "Release runs issue 19's 1,000 paths");
 constexpr int kStepsPerPath = 16;
 constexpr double kSinkToleranceMm = 0.2;
 
@@ -120,10 +126,14 @@ TEST(NucleusRemovalFuzz, RandomChopAspirateAndUltrasoundPathsKeepTheLensSound) {
     cracked += l.cracks > 0;
     removed += l.cells_removed > start.cells_removed;
   }
-  // The paths do what they are for: some crack, some hold a fragment, many remove cells.
-  EXPECT_GT(cracked, 10u);
+  // The paths do what they are for: some crack, some hold a fragment, many remove cells (the
+  // bounds are per 1,000 paths, scaled to the paths run).
+  std::printf("%d paths: %llu cracked, %llu removed cells, %llu fragment-held steps\n", kPaths,
+              static_cast<unsigned long long>(cracked), static_cast<unsigned long long>(removed),
+              static_cast<unsigned long long>(held));
+  EXPECT_GT(cracked, 10u * kPaths / 1000);
   EXPECT_GT(held, 0u);
-  EXPECT_GT(removed, 100u);
+  EXPECT_GT(removed, 100u * kPaths / 1000);
 }
 
 }  // namespace
