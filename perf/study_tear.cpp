@@ -30,8 +30,9 @@ namespace fs = std::filesystem;
 constexpr double kExpertLo = 6, kExpertHi = 14, kNovice = 17, kPerforationLo = 15,
                  kPerforationHi = 35, kRim = 150, kRimSpread = 70;
 // A frame's force above F_c by more than this fraction is off the plateau (the dynamics answer the
-// tear a frame late: tests/procedures/scene/test_tear_force.cpp uses the same margin).
-constexpr double kPlateauMargin = 0.35;
+// tear a frame late: tests/procedures/scene/test_tear_force.cpp uses the same margin, 0.35 until
+// the held flap folded after the frame's edits, not before: docs/cutting_and_tearing.md).
+constexpr double kPlateauMargin = 0.1;
 
 struct TearRun {
   std::string file, difficulty;

@@ -68,7 +68,7 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
           gap_fq = std::numeric_limits<float>::infinity();
   };
   const Candidates cand = parallel_reduce_ordered(
-      0u, n, kGrain, Candidates{},
+      0u, n, kCrackGrain, Candidates{},
       [&](uint32_t b, uint32_t e) {
         Candidates s;
         for (uint32_t i = b; i < e; ++i) {

@@ -18,7 +18,7 @@ namespace {
 // A chain of phases over `n` values, double-buffered: phase p reads the whole of buffer[p % 2]
 // (so a chunk that ran before all of phase p − 1 had finished would read stale values) and writes
 // its range of buffer[(p + 1) % 2]; the gate stops once the sum passes a limit.
-struct Chain {
+struct PhaseChain {
   uint32_t n = 1000, chunks = 10;
   std::vector<double> buffer[2] = {std::vector<double>(n, 1.0), std::vector<double>(n, 0.0)};
   std::vector<uint32_t> runs_of_chunk;  // per (phase, chunk)
@@ -57,7 +57,7 @@ TEST(PhasedTeam, EveryChunkRunsOnceAndTheGateOncePerPhase) {
     SCOPED_TRACE(threads);
     tbb::task_arena arena(threads);
     arena.execute([&] {
-      Chain c;
+      PhaseChain c;
       PhasedTeam team(true);
       const uint64_t stopped = c.run(team, 40);
       EXPECT_EQ(stopped, 40u) << "no gate said stop: the limit is far";
@@ -76,7 +76,7 @@ TEST(PhasedTeam, ATeamOfTwoGivesTheBitsOfOneThread) {
   for (int threads : {1, 2}) {
     tbb::task_arena arena(threads);
     arena.execute([&] {
-      Chain c;
+      PhaseChain c;
       c.limit = 5e4;  // passed after a few dozen phases
       PhasedTeam team(true);
       stopped[threads - 1] = c.run(team, 1000);
