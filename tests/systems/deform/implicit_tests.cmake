@@ -6,6 +6,9 @@ phaco_test(test_implicit
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit_active.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit_predictor.cpp
   LIBS phaco_sys_deform phaco_sys_springs phaco_sys_active_nodes phaco_eye TBB::tbb)
+# Not in unity batches (PHACO_UNITY_BUILD): its three files each define the frame step and helpers
+# of the same names at file scope, as the deform library itself is kept out.
+set_target_properties(test_implicit PROPERTIES UNITY_BUILD OFF)
 # Implicit Euler's linear solve: operator, preconditioners, threaded product (implicit_solver.cpp).
 phaco_test(test_implicit_solver
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_implicit_solver.cpp
