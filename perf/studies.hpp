@@ -2,12 +2,26 @@
 // The studies phaco-perf runs. Each measures, writes perf/results/<study>.csv/.json, its charts
 // perf/results/<study>_*.png and its markdown section perf/results/<study>.md, then RESULTS.md is
 // reassembled from every section present (perf/report.hpp).
+#include <charconv>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "engine/core/error.hpp"
+
 namespace phaco::perf {
+
+// A study option's whole-number value: "sweep: --max-level expects a whole number, got 'x'" as an
+// input error (never std::stoi's bare "stoi"). Range checks stay with each option.
+inline int option_int(const std::string& study, const std::string& option,
+                      const std::string& text) {
+  int v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc{} || end != text.data() + text.size())
+    throw InputError(study + ": " + option + " expects a whole number, got '" + text + "'");
+  return v;
+}
 
 struct StudyOptions {
   bool quick = false;              // small levels, few steps: about a minute, for CI

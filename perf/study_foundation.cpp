@@ -94,11 +94,11 @@ void foundation(const StudyOptions& options) {
       return args[++i];
     };
     if (args[i] == "--max-level") {
-      max_level = std::stoi(value());
+      max_level = option_int("foundation", "--max-level", value());
       if (max_level < eye::kMinLevel || max_level > eye::kMaxLevel)
         throw InputError("foundation: --max-level out of 0.." + std::to_string(eye::kMaxLevel));
     } else if (args[i] == "--frames-repeat") {
-      repeats = std::max(1, std::stoi(value()));
+      repeats = std::max(1, option_int("foundation", "--frames-repeat", value()));
     } else if (args[i] == "--scenario") {
       scenario_file = value();
     } else {

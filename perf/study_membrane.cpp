@@ -68,7 +68,7 @@ void run_membrane(const StudyOptions& options) {
   int max_level = options.quick ? 3 : 7;  // level 8 on request (--max-level 8)
   for (size_t i = 0; i < options.extra.size(); ++i) {
     if (options.extra[i] == "--max-level" && i + 1 < options.extra.size()) {
-      max_level = std::stoi(options.extra[++i]);
+      max_level = option_int("membrane", "--max-level", options.extra[++i]);
       if (max_level < eye::kMinLevel || max_level > eye::kMaxLevel)
         throw InputError("membrane: --max-level out of 0.." + std::to_string(eye::kMaxLevel));
     } else {

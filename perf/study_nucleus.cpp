@@ -35,7 +35,7 @@ void run_nucleus(const StudyOptions& options) {
   int max_level = options.quick ? 1 : 3;
   for (size_t i = 0; i < options.extra.size(); ++i) {
     if (options.extra[i] == "--max-level" && i + 1 < options.extra.size()) {
-      max_level = std::stoi(options.extra[++i]);
+      max_level = option_int("nucleus", "--max-level", options.extra[++i]);
       if (max_level < 0 || max_level > 5) throw InputError("nucleus: --max-level expects 0..5");
     } else {
       throw InputError("nucleus: unknown option '" + options.extra[i] + "'");

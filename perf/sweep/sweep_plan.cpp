@@ -43,7 +43,7 @@ SweepArgs parse_sweep_args(const StudyOptions& options) {
   a.max_level = options.quick ? 3 : eye::kMaxLevel;
   bool drills_given = false;
   auto number = [&](size_t& i, const char* what, int lo, int hi) {
-    const int v = std::stoi(options.extra[++i]);
+    const int v = option_int("sweep", what, options.extra[++i]);
     if (v < lo || v > hi)
       throw InputError(std::string("sweep: ") + what + " out of " + std::to_string(lo) + ".." +
                        std::to_string(hi));
