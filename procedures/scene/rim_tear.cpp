@@ -9,6 +9,7 @@
 #include "components/particles.hpp"
 #include "components/tool.hpp"
 #include "components/triangles.hpp"
+#include "engine/io/tool_shape.hpp"
 #include "procedures/scene/capsule_cutting.hpp"
 #include "procedures/scene/capsule_physics.hpp"
 #include "procedures/scene/scene.hpp"
@@ -237,11 +238,14 @@ bool press_rim(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, double time_s)
   for (size_t k = 0; k < scene.tools.size(); ++k) {
     const double r = rt.tool_radius_mm[k];
     if (r <= 0) continue;
-    const ToolState& pose = scene.world.at<ToolState>(scene.tools[k]);
-    const Vec3 shaft = pose.quat.normalized() * Vec3::UnitZ();
+    // The shaft presses the rim where its axis crosses the capsule: beside the tip for a bent
+    // chopper or hook (engine/io/tool_shape.hpp), through it for the probe.
+    const ShaftAxis axis = shaft_axis(scene.world.at<ToolState>(scene.tools[k]),
+                                      scene.world.at<Tool>(scene.tools[k]).kind);
+    const Vec3& shaft = axis.direction;
     if (const int i = driven_by(rt, k); i >= 0) {
       RimTear& t = rt.tears[static_cast<size_t>(i)];
-      const double depth = push_on(t, pose.pos, shaft, r, s, 4.0 * r);
+      const double depth = push_on(t, axis.point, shaft, r, s, 4.0 * r);
       if (depth > 0) {
         t.pushed_mm = std::max(t.pushed_mm, depth);
         rt.tool_max_force_mn[k] = std::max(rt.tool_max_force_mn[k], s.stiffness_mn_mm * depth);
@@ -253,7 +257,7 @@ bool press_rim(Scene& scene, cut::CutMesh& m, CapsuleCutting& cc, double time_s)
       }
       t.driven = false;  // withdrawn: its tip stays on the rim as a notch
     }
-    const RimPress p = rim_press(m, rt.rim, pose.pos, shaft, r, s);
+    const RimPress p = rim_press(m, rt.rim, axis.point, shaft, r, s);
     rt.presses[k] = p;
     if (!p.crossing) continue;
     rt.min_clearance_mm = std::min(rt.min_clearance_mm, -p.depth_mm);

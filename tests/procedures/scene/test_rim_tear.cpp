@@ -7,10 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "engine/io/tool_shape.hpp"
 #include "engine/io/track.hpp"
 #include "procedures/eye/eye_params.hpp"
 #include "procedures/procedure/carry.hpp"
@@ -21,6 +23,7 @@
 #include "procedures/scene/drill_metrics.hpp"
 #include "procedures/scene/rim_tear.hpp"
 #include "procedures/scene/scene.hpp"
+#include "systems/lens_tools/cell_dynamics.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
@@ -199,6 +202,35 @@ TEST(RimTear, ANickedRimTearsAtTheTearResistance) {
   EXPECT_GT(t->pushed_mm, 0.3);  // the probe sits in the nick, wedging its lips apart
   EXPECT_FALSE(t->to_equator);
   EXPECT_TRUE(drill_report(*scene).complications.empty());
+}
+
+// A bent chopper presses the rim with its shaft, 1 mm beside its tip (engine/io/tool_shape.hpp):
+// turned so that its bend points along −x, its tip just reaching the rim while its shaft is 1 mm
+// past it, the rim feels the shaft's 1 mm. Measured on the tip's line it felt nothing.
+TEST(RimTear, ABentChopperPressesTheRimWithItsShaftNotItsTip) {
+  const Opened o = opened_capsule(false);
+  Scenario s = test::repo_scenario("nucleus_removal_expert.json");
+  s.eye.level = 0;
+  const double r = lens_tools::HookSettings{}.radius_mm;
+  const Quat bend_to_minus_x(Eigen::AngleAxisd(0.5 * std::numbers::pi, Vec3::UnitZ()));
+  ASSERT_LT((bend_to_minus_x * shaft_offset_local(ToolKind::Chopper) - Vec3(-kChopperBendMm, 0, 0))
+                .norm(),
+            1e-12);
+  const double tip_x = -(o.rim_mm - r);  // the tip's section just at the rim
+  for (HandTrack& h : s.hands) {
+    if (h.tool == ToolKind::Chopper)
+      h.track = {{0.0, Vec3(0.0, 0.0, 0.3), bend_to_minus_x, 0, 0},
+                 {0.3, Vec3(tip_x, 0.0, 0.0), bend_to_minus_x, 0, 0},
+                 {0.5, Vec3(tip_x, 0.0, 0.0), bend_to_minus_x, 0, 0}};
+    else  // the probe waits in the opening's middle
+      h.track = {{0.0, Vec3(0.0, 0.0, 0.3), Quat::Identity(), 0, 0}};
+  }
+  s.duration_s = 0.5;
+  auto scene = run_on(s, o.carried);
+  const RimTears& rim = rim_of(*scene);
+  const double k = eye::default_eye_params().get("capsule.rim_stiffness_mn_mm");
+  EXPECT_NEAR(rim.max_force_mn, k * kChopperBendMm, 0.1 * k);
+  EXPECT_TRUE(rim.tears.empty());  // 1 mm on a smooth rim is below its strength
 }
 
 // A drill alone starts with a whole capsule: no opening, no rim, nothing torn or reported, however
