@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <exception>
 #include <filesystem>
@@ -60,6 +61,24 @@ void summarise(DrillCohorts& c) {
   c.novices_pass = share_at_or_above(c.novices, c.cutoff);
 }
 
+// Where a member's score went: each term that lost points, as "metric -points", most first.
+std::string lost_points(const nlohmann::json& terms) {
+  std::vector<std::pair<double, std::string>> lost;
+  for (const auto& term : terms) {
+    const double gone = term.value("weight", 0.0) - term.value("points", 0.0);
+    if (gone > 0.05) lost.emplace_back(gone, term.value("metric", std::string("?")));
+  }
+  std::sort(lost.begin(), lost.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::string out;
+  char buf[32];
+  for (const auto& [gone, metric] : lost) {
+    std::snprintf(buf, sizeof buf, " -%.1f", gone);
+    out += (out.empty() ? "" : "; ") + metric + buf;
+  }
+  return out;
+}
+
 // The rows of the drills not run this time, from the results of an earlier run (cohorts.json),
 // so that `--drill X` adds X's rows without dropping the others'. Rows written before the run
 // column existed say so.
@@ -87,7 +106,8 @@ std::vector<DrillCohorts> kept_rows(const fs::path& json, const std::vector<std:
       (expert ? c.experts : c.novices).push_back(score);
       (expert ? c.experts_failed : c.novices_failed) += failed;
       t.add({drill, r.value("group", ""), r.value("member", 0.0), r.value("script", ""),
-             r.value("seed", 0.0), score, failed ? 1.0 : 0.0, c.run});
+             r.value("seed", 0.0), score, failed ? 1.0 : 0.0, r.value("lost", std::string()),
+             c.run});
     }
     if (c.experts.empty() || c.novices.empty()) continue;
     summarise(c);
@@ -129,7 +149,7 @@ void run_cohorts(const StudyOptions& options) {
 
   Progress progress(static_cast<int>(drills.size()) * 2 * n + 1);
   Table t;
-  t.columns = {"drill", "group", "member", "script", "seed", "score", "failed", "run"};
+  t.columns = {"drill", "group", "member", "script", "seed", "score", "failed", "lost", "run"};
   // This run, as its section names it beside each drill's rows.
   const std::time_t now = std::time(nullptr);
   char stamp[32];
@@ -155,6 +175,7 @@ void run_cohorts(const StudyOptions& options) {
       uint64_t seed = 0;
       double score = 0;
       bool failed = false;
+      std::string lost;  // the score terms that lost points, "metric -points; ..."
     };
     std::vector<Member> members;
     for (int group = 0; group < 2; ++group)
@@ -176,6 +197,7 @@ void run_cohorts(const StudyOptions& options) {
           cohort_member(base, mb.group == 0 ? expert_spec() : novice_spec(), mb.seed), scene);
       mb.score = r.metrics.value("score", 0.0);
       mb.failed = !r.complications.empty();
+      mb.lost = lost_points(r.score_terms);
     };
     run_member(members.front());
     std::vector<std::thread> workers;
@@ -197,7 +219,7 @@ void run_cohorts(const StudyOptions& options) {
       (mb.group == 0 ? c.experts_failed : c.novices_failed) += mb.failed;
       t.add({drill, std::string(mb.group == 0 ? "expert" : "novice"), double(mb.m),
              mb.script.filename().string(), double(mb.seed), mb.score, mb.failed ? 1.0 : 0.0,
-             this_run});
+             mb.lost, this_run});
     }
     summarise(c);
     out.push_back(std::move(c));
