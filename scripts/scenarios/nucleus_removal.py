@@ -17,8 +17,11 @@ guidance.trench_cross: one trench along x, one along y, 1.35 mm wide, 80 % deep)
      into the tip; lift.
 --dip      (novice) after the second quadrant the probe dips through the posterior capsule at the
            centre: a rupture.
---wasteful (novice) ultrasound (pedal 3) instead of aspiration while occluding, and on for two
-           extra seconds in the empty bag after every quadrant: far more CDE.
+--wasteful (novice) ultrasound (pedal 3) instead of aspiration while occluding, three seconds more
+           of it on each quadrant (chasing it instead of letting the vacuum feed it in) and 3.5 s
+           in the empty bag after it: about 1.6x the expert's CDE, so that the defect outlasts a
+           cohort's +-15 % tempo (perf/cohorts). (Ultrasound on the way into a quadrant, tried,
+           pushed the quadrants away from the unoccluded tip: a removal defect too.)
 Each tool pivots in its corneal port (scripts/scenarios/ports.py): the probe in the main incision
 (3 o'clock), the chopper in the side port (11 o'clock).
 """
@@ -110,14 +113,17 @@ for k, (sx, sy) in enumerate(((1, 1), (1, -1), (-1, 1), (-1, -1))):
     both(0.05, [sx * 1.6, sy * 1.6, -0.2], occlude_pedal, chopper_park)
     both(1.2, [sx * 0.5, sy * 0.5, 0.0], occlude_pedal, chopper_park)
     both(0.05, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)
-    both(args.quadrant_s, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)
+    both(args.quadrant_s + (3.0 if args.wasteful else 0.0), [sx * 0.5, sy * 0.5, 0.0], 3,
+         chopper_park)
     if args.wasteful:
-        both(2.0, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)   # ultrasound in the empty bag
+        both(3.5, [sx * 0.5, sy * 0.5, 0.0], 3, chopper_park)   # ultrasound in the empty bag
     both(0.05, [sx * 0.5, sy * 0.5, 0.0], 1, chopper_park)
     both(0.4, [sx * 1.0, sy * 1.0, 1.6], 1, chopper_park)
     if args.dip and k == 1:
         both(0.6, [0.0, 0.0, 0.0], 1, chopper_park)
-        both(0.6, [0.0, 0.0, -2.9], 1, chopper_park)   # through the posterior pole (z = -2.7)
+        # through the posterior pole (z = -2.7) by 0.8 mm: more than 5 sigma of a cohort's
+        # offsets (perf/cohorts, 0.15 mm per axis), which at 0.2 mm past it missed 2 ruptures of 4
+        both(0.6, [0.0, 0.0, -3.5], 1, chopper_park)
         both(0.6, [0.0, 0.0, 1.6], 1, chopper_park)
 # What is left rests at the bottom of the bag's bowl: occlude on it there and emulsify it.
 both(0.6, [0.3, 0.0, 1.0], 1, chopper_park)
