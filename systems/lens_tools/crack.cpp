@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
@@ -13,7 +14,7 @@ namespace phaco::lens_tools {
 namespace {
 
 constexpr uint32_t kNone = 0xffffffffu;
-constexpr uint32_t kCrackGrain = 8192;  // cells per chunk of the nearest-cell scan
+constexpr uint32_t kCrackGrain = 8192;  // cells per chunk of the scan near the tips
 
 struct Nearest {
   uint32_t cell = kNone;
@@ -28,32 +29,42 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
   CrackPush out;
   const Vec3f p = probe_tip.cast<float>(), q = chopper_tip.cast<float>();
   const Vec3f m = 0.5f * (p + q);
-  // Nearest cells to each tip (the lowest id among equals), over fixed chunks merged in id order:
-  // the same cells as one walk in id order, for any thread count.
-  struct Scan {
-    Nearest np, nq;
-  };
+  const float contact2 = static_cast<float>(s.contact_radius_mm * s.contact_radius_mm);
+  const float gap_r2 = static_cast<float>(s.gap_radius_mm * s.gap_radius_mm);
+  // Every test below compares a distance with the contact radius (a tip touching a cell) or the
+  // gap radius (a cell at the midpoint), so only the alive cells within those balls decide it: a
+  // tip with no cell within the contact radius touches nothing, and then neither candidate
+  // fragment engages. One scan lists those cells (a few dozen), in id order over fixed chunks
+  // merged in id order; the nearest cells found on that list in id order (the lowest id among
+  // equals) are the nearest over all cells, for any thread count. (It was two scans over every
+  // cell: the nearest cell to each tip, then each candidate fragment's cells.)
   const uint32_t n = static_cast<uint32_t>(c.x.size());
-  const Scan scan = parallel_reduce_ordered(
-      0u, n, kCrackGrain, Scan{},
+  const std::vector<uint32_t> near = parallel_reduce_ordered(
+      0u, n, kCrackGrain, std::vector<uint32_t>{},
       [&](uint32_t b, uint32_t e) {
-        Scan s;
+        std::vector<uint32_t> ids;
         for (uint32_t i = b; i < e; ++i) {
           if (!c.alive[i]) continue;
           const Vec3f x(c.x[i], c.y[i], c.z[i]);
-          const float dp = (x - p).squaredNorm(), dq = (x - q).squaredNorm();
-          if (dp < s.np.d2) s.np = {i, dp};
-          if (dq < s.nq.d2) s.nq = {i, dq};
+          if ((x - p).squaredNorm() <= contact2 || (x - q).squaredNorm() <= contact2 ||
+              (x - m).squaredNorm() < gap_r2)
+            ids.push_back(i);
         }
-        return s;
+        return ids;
       },
-      [](Scan a, const Scan& b) {
-        if (b.np.d2 < a.np.d2) a.np = b.np;
-        if (b.nq.d2 < a.nq.d2) a.nq = b.nq;
+      [](std::vector<uint32_t> a, const std::vector<uint32_t>& b) {
+        a.insert(a.end(), b.begin(), b.end());
         return a;
       });
+  Nearest np_any, nq_any;  // nearest cell to each tip, if within the contact radius
+  for (const uint32_t i : near) {
+    const Vec3f x(c.x[i], c.y[i], c.z[i]);
+    const float dp = (x - p).squaredNorm(), dq = (x - q).squaredNorm();
+    if (dp <= contact2 && dp < np_any.d2) np_any = {i, dp};
+    if (dq <= contact2 && dq < nq_any.d2) nq_any = {i, dq};
+  }
   const double separation = (probe_tip - chopper_tip).norm();
-  if (scan.np.cell == kNone || scan.nq.cell == kNone || separation <= 0) {
+  if (np_any.cell == kNone || nq_any.cell == kNone || separation <= 0) {
     state = CrackState{};
     return out;
   }
@@ -61,50 +72,34 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
   // cell of it and the nearest cell of it to the midpoint. Only its own cells bridge its trench: a
   // piece of another fragment lying in the trench (a quadrant that slid in after an earlier crack,
   // as the finer lenses' pieces do) holds nothing together.
-  const uint32_t fp = c.label[scan.np.cell], fq = c.label[scan.nq.cell];
-  struct Candidates {
-    Nearest q_on_fp, p_on_fq;
-    float gap_fp = std::numeric_limits<float>::infinity(),
-          gap_fq = std::numeric_limits<float>::infinity();
-  };
-  const Candidates cand = parallel_reduce_ordered(
-      0u, n, kCrackGrain, Candidates{},
-      [&](uint32_t b, uint32_t e) {
-        Candidates s;
-        for (uint32_t i = b; i < e; ++i) {
-          if (!c.alive[i] || (c.label[i] != fp && c.label[i] != fq)) continue;
-          const Vec3f x(c.x[i], c.y[i], c.z[i]);
-          const float dm = (x - m).squaredNorm();
-          if (c.label[i] == fp) {
-            const float dq = (x - q).squaredNorm();
-            if (dq < s.q_on_fp.d2) s.q_on_fp = {i, dq};
-            s.gap_fp = std::min(s.gap_fp, dm);
-          }
-          if (c.label[i] == fq) {
-            const float dp = (x - p).squaredNorm();
-            if (dp < s.p_on_fq.d2) s.p_on_fq = {i, dp};
-            s.gap_fq = std::min(s.gap_fq, dm);
-          }
-        }
-        return s;
-      },
-      [](Candidates a, const Candidates& b) {
-        if (b.q_on_fp.d2 < a.q_on_fp.d2) a.q_on_fp = b.q_on_fp;
-        if (b.p_on_fq.d2 < a.p_on_fq.d2) a.p_on_fq = b.p_on_fq;
-        a.gap_fp = std::min(a.gap_fp, b.gap_fp);
-        a.gap_fq = std::min(a.gap_fq, b.gap_fq);
-        return a;
-      });
-  const float contact2 = static_cast<float>(s.contact_radius_mm * s.contact_radius_mm);
-  const float gap_r2 = static_cast<float>(s.gap_radius_mm * s.gap_radius_mm);
-  // Each tip touching the fragment, the trench (none of its cells) at their midpoint.
-  const bool on_fp = scan.np.d2 <= contact2 && cand.q_on_fp.d2 <= contact2 && cand.gap_fp >= gap_r2;
-  const bool on_fq = scan.nq.d2 <= contact2 && cand.p_on_fq.d2 <= contact2 && cand.gap_fq >= gap_r2;
+  const uint32_t fp = c.label[np_any.cell], fq = c.label[nq_any.cell];
+  Nearest q_on_fp, p_on_fq;
+  float gap_fp = std::numeric_limits<float>::infinity(),
+        gap_fq = std::numeric_limits<float>::infinity();
+  for (const uint32_t i : near) {
+    if (c.label[i] != fp && c.label[i] != fq) continue;
+    const Vec3f x(c.x[i], c.y[i], c.z[i]);
+    const float dm = (x - m).squaredNorm();
+    if (c.label[i] == fp) {
+      const float dq = (x - q).squaredNorm();
+      if (dq < q_on_fp.d2) q_on_fp = {i, dq};
+      gap_fp = std::min(gap_fp, dm);
+    }
+    if (c.label[i] == fq) {
+      const float dp = (x - p).squaredNorm();
+      if (dp < p_on_fq.d2) p_on_fq = {i, dp};
+      gap_fq = std::min(gap_fq, dm);
+    }
+  }
+  // Each tip touching the fragment, the trench (none of its cells) at their midpoint. A listed
+  // cell's distance decides these as an unlisted one's would: beyond the radius either way.
+  const bool on_fp = q_on_fp.d2 <= contact2 && gap_fp >= gap_r2;
+  const bool on_fq = p_on_fq.d2 <= contact2 && gap_fq >= gap_r2;
   if (!on_fp && !on_fq) {
     state = CrackState{};
     return out;
   }
-  const Nearest np = on_fp ? scan.np : cand.p_on_fq, nq = on_fp ? cand.q_on_fp : scan.nq;
+  const Nearest np = on_fp ? np_any : p_on_fq, nq = on_fp ? q_on_fp : nq_any;
   const uint32_t fragment = c.label[np.cell];
   if (!state.engaged || state.fragment != fragment) {
     state.engaged = true;

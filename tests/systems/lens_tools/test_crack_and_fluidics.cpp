@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
+#include "engine/core/rng.hpp"
 #include "systems/lens_tools/crack.hpp"
 #include "systems/lens_tools/fluidics.hpp"
 
@@ -92,6 +94,105 @@ TEST(Crack, APieceOfAnotherFragmentLyingInTheTrenchDoesNotBridgeIt) {
   s.label.back() = 0;
   state = {};
   EXPECT_FALSE(push_apart(s.view(), Vec3(0.45, 0, 0), Vec3(-0.45, 0, 0), {}, state).engaged);
+}
+
+// The rule as written in crack.hpp, walked over every cell: the nearest alive cell to each tip,
+// then per candidate fragment the other tip's nearest cell of it and its nearest cell to the
+// midpoint (lowest id among equals). push_apart looks only near the tips; it must decide alike.
+CrackPush push_apart_over_every_cell(const CrackCells& c, const Vec3& probe, const Vec3& chopper,
+                                     const CrackSettings& s, CrackState& state) {
+  constexpr uint32_t kNo = 0xffffffffu;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const Vec3f p = probe.cast<float>(), q = chopper.cast<float>(), m = 0.5f * (p + q);
+  auto d2 = [&](uint32_t i, const Vec3f& t) {
+    return (Vec3f(c.x[i], c.y[i], c.z[i]) - t).squaredNorm();
+  };
+  auto nearest = [&](const Vec3f& t, uint32_t label, float& best) {
+    uint32_t at = kNo;
+    best = kInf;
+    for (uint32_t i = 0; i < c.x.size(); ++i)
+      if (c.alive[i] && (label == kNo || c.label[i] == label) && d2(i, t) < best)
+        best = d2(i, t), at = i;
+    return at;
+  };
+  CrackPush out;
+  float dp = kInf, dq = kInf;
+  const uint32_t np = nearest(p, kNo, dp), nq = nearest(q, kNo, dq);
+  const double separation = (probe - chopper).norm();
+  if (np == kNo || nq == kNo || separation <= 0) return state = {}, out;
+  const uint32_t fp = c.label[np], fq = c.label[nq];
+  float q_fp = kInf, p_fq = kInf, gap_fp = kInf, gap_fq = kInf;
+  const uint32_t q_on_fp = nearest(q, fp, q_fp), p_on_fq = nearest(p, fq, p_fq);
+  nearest(m, fp, gap_fp), nearest(m, fq, gap_fq);
+  const float contact2 = float(s.contact_radius_mm * s.contact_radius_mm);
+  const float gap2 = float(s.gap_radius_mm * s.gap_radius_mm);
+  const bool on_fp = dp <= contact2 && q_fp <= contact2 && gap_fp >= gap2;
+  const bool on_fq = dq <= contact2 && p_fq <= contact2 && gap_fq >= gap2;
+  if (!on_fp && !on_fq) return state = {}, out;
+  const uint32_t a = on_fp ? np : p_on_fq, b = on_fp ? q_on_fp : nq;
+  if (!state.engaged || state.fragment != c.label[a]) state = {true, separation, c.label[a]};
+  state.rest_separation_mm = std::min(state.rest_separation_mm, separation);
+  out.engaged = true;
+  out.fragment = c.label[a];
+  out.force_mn = s.stiffness_mn_mm * (separation - state.rest_separation_mm);
+  out.crack_force_mn = s.strength_mn * 0.5 * (double(c.hardness[a]) + double(c.hardness[b]));
+  out.crack = out.force_mn >= out.crack_force_mn;
+  out.mid = m.cast<double>();
+  out.normal = (probe - chopper) / separation;
+  if (out.crack) state = {};
+  return out;
+}
+
+TEST(Crack, LooksOnlyNearTheTipsYetDecidesAsAWalkOverEveryCell) {
+  // The slabs cut into four fragments with some cells gone and crumbs of a fifth in the trench;
+  // tip pairs across the trench, inside a slab, astride two fragments and far away, each pair
+  // spreading over a few frames. Every output and the state must match the walk over every cell.
+  Slabs s;
+  const CounterRng rng(19, 3);
+  for (size_t i = 0; i < s.x.size(); ++i) {
+    s.label[i] = (s.y[i] > 0.3f ? 1u : 0u) + (s.z[i] > 0.5f ? 2u : 0u);
+    s.alive[i] = rng.uniform(0, uint32_t(i)) > 0.1f;
+    s.hardness[i] = 0.3f + 0.4f * rng.uniform(1, uint32_t(i));
+  }
+  for (const float py : {-0.4f, 0.2f, 0.6f})
+    s.x.push_back(0.1f), s.y.push_back(py), s.z.push_back(0), s.hardness.push_back(0.5f),
+        s.alive.push_back(1), s.label.push_back(4);
+  CrackSettings cs;
+  cs.strength_mn = 8;  // cracks within the spreads below
+  CrackState fast, walk;
+  int engaged = 0, cracked = 0, disengaged = 0;
+  for (uint32_t pair = 0; pair < 400; ++pair) {
+    auto u = [&](uint32_t k) { return double(rng.uniform(2 + pair, k)); };
+    const Vec3 centre(6 * u(0) - 3, 2.4 * u(1) - 1.2, 2.4 * u(2) - 1.2);
+    const double half = 0.3 + 0.5 * u(3);
+    Vec3 axis(1, 0.3 * (u(4) - 0.5), 0.3 * (u(5) - 0.5));
+    axis.normalize();
+    if (pair % 3 == 0) axis = Vec3(u(6) - 0.5, u(7) - 0.5, u(8) - 0.5).normalized();
+    const Vec3 at = pair % 2 ? Vec3(0, centre.y(), centre.z()) : centre;
+    for (int frame = 0; frame < 6; ++frame) {
+      const double spread = half + 0.05 * frame;
+      const Vec3 probe = at + spread * axis, chopper = at - spread * axis;
+      const CrackPush a = push_apart(s.view(), probe, chopper, cs, fast);
+      const CrackPush b = push_apart_over_every_cell(s.view(), probe, chopper, cs, walk);
+      ASSERT_EQ(a.engaged, b.engaged) << pair << " " << frame;
+      ASSERT_EQ(a.crack, b.crack) << pair << " " << frame;
+      ASSERT_EQ(a.fragment, b.fragment) << pair << " " << frame;
+      ASSERT_EQ(a.force_mn, b.force_mn) << pair << " " << frame;
+      ASSERT_EQ(a.crack_force_mn, b.crack_force_mn) << pair << " " << frame;
+      if (a.engaged) {
+        ASSERT_TRUE(a.mid == b.mid);
+        ASSERT_TRUE(a.normal == b.normal);
+      }
+      ASSERT_EQ(fast.engaged, walk.engaged);
+      ASSERT_EQ(fast.fragment, walk.fragment);
+      ASSERT_EQ(fast.rest_separation_mm, walk.rest_separation_mm);
+      engaged += a.engaged, cracked += a.crack, disengaged += !a.engaged;
+    }
+  }
+  // The cases covered all three outcomes, often.
+  EXPECT_GT(engaged, 100);
+  EXPECT_GT(cracked, 20);
+  EXPECT_GT(disengaged, 500);
 }
 
 TEST(Crack, LinksAcrossThePlaneAreThoseJoiningItsTwoSides) {
