@@ -318,10 +318,10 @@ void restrict_through_a(const PreconditionerState& state, uint32_t nu, const dou
   }
 }
 
-// t −= (A·P₀)·e.
-void subtract_through_a(const PreconditionerState& state, uint32_t nu, const Eigen::VectorXd& e,
-                        double* t) {
-  for (uint32_t u = 0; u < nu; ++u) {
+// t −= (A·P₀)·e over rows [begin, end).
+void subtract_through_a(const PreconditionerState& state, uint32_t begin, uint32_t end,
+                        const Eigen::VectorXd& e, double* t) {
+  for (uint32_t u = begin; u < end; ++u) {
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
     for (uint32_t b = state.ap_begin[u]; b < state.ap_begin[u + 1]; ++b) {
       const Sym3& k = state.ap_block[b];
@@ -390,11 +390,35 @@ void apply_deflation(const ImplicitCache& cache, const double* r, double* z) {
   restrict_constant(state, nu, r, state.coarse_rhs);
   coarse_solve(state);
   Eigen::Map<Eigen::VectorXd>(t.data(), size) = Eigen::Map<const Eigen::VectorXd>(r, size);
-  subtract_through_a(state, nu, state.coarse_solution, t.data());
+  subtract_through_a(state, 0, nu, state.coarse_solution, t.data());
   apply_block_inverse(state.inverse_block, t.data(), z, 1.0, false, settings);
   restrict_through_a(state, nu, z, state.coarse_rhs, -1.0);
   coarse_solve(state);
   prolong_constant(state, nu, state.coarse_solution, z, 1.0);
+}
+
+double deflation_coarse_step(const ImplicitCache& cache, const double* t, const double* r) {
+  const PreconditionerState& state = *cache.preconditioner;
+  if (!state.coarse_valid) return 0.0;
+  const uint32_t nu = cache.pattern.rows();
+  restrict_constant(state, nu, t, state.coarse_rhs);
+  coarse_solve(state);
+  if (!r) return 0.0;
+  Eigen::VectorXd& c = state.coarse_work;  // coarse_solve is done with it
+  restrict_constant(state, nu, r, c);
+  return c.dot(state.coarse_solution);
+}
+
+void add_coarse_correction(const PreconditionerState& state, uint32_t begin, uint32_t end,
+                           double y_sign, double* y, double* ay) {
+  if (!state.coarse_valid) return;
+  subtract_through_a(state, begin, end, state.coarse_solution, ay);
+  const double* e = state.coarse_solution.data();
+  for (uint32_t u = begin; u < end; ++u) {
+    const uint32_t agg = state.aggregate_of_unknown[u];
+    if (agg == kNotUnknown) continue;
+    for (int a = 0; a < 3; ++a) y[3 * u + a] += y_sign * e[3 * agg + a];
+  }
 }
 
 void deflate_guess(ImplicitCache& cache) {

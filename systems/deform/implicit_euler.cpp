@@ -348,7 +348,7 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
   team.emplace(nu >= cache.settings.cg_team_min_rows);
   assemble(m, dt, cache, *team);
   const bool row_chunked = cache.settings.cg_operator == CgOperator::MatrixFree &&
-                           implicit_detail::row_local_preconditioner(cache.settings.preconditioner);
+                           implicit_detail::team_cg_preconditioner(cache.settings.preconditioner);
   if (!row_chunked) team.reset();
   // Step 4. Diagonal preconditioners follow A every step; a factored one is rebuilt with the
   // pattern only (a stale factor is still SPD: CG stays valid, only its speed depends on it).

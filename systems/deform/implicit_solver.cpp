@@ -6,6 +6,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <optional>
 
 #include "engine/schedule/parallel.hpp"
 #include "engine/schedule/phased_team.hpp"
@@ -384,19 +385,20 @@ void solve_with(const Operator& op, ImplicitCache& cache) {
 
 }  // namespace
 
-bool row_local_preconditioner(Preconditioner p) {
-  return p == Preconditioner::Jacobi || p == Preconditioner::BlockJacobi;
+bool team_cg_preconditioner(Preconditioner p) {
+  return p == Preconditioner::Jacobi || p == Preconditioner::BlockJacobi ||
+         p == Preconditioner::Deflation;
 }
 
 void solve_linear_system(ImplicitCache& cache, PhasedTeam* team) {
-  if (cache.settings.cg_operator == CgOperator::MatrixFree &&
-      row_local_preconditioner(cache.settings.preconditioner)) {
-    if (team) {
+  const Preconditioner p = cache.settings.preconditioner;
+  if (cache.settings.cg_operator == CgOperator::MatrixFree && team_cg_preconditioner(p)) {
+    std::optional<PhasedTeam> own;
+    if (!team) team = &own.emplace(cache.pattern.rows() >= cache.settings.cg_team_min_rows);
+    if (p == Preconditioner::Deflation)
+      solve_deflated_team(cache, *team);
+    else
       solve_row_chunked(cache, *team);
-    } else {
-      PhasedTeam own(cache.pattern.rows() >= cache.settings.cg_team_min_rows);
-      solve_row_chunked(cache, own);
-    }
     return;
   }
   if (cache.settings.preconditioner == Preconditioner::Deflation) deflate_guess(cache);

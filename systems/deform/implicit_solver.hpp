@@ -103,6 +103,8 @@ struct PreconditionerState {
   std::vector<int> coarse_group_begin;  // columns of L solved together (implicit_deflation.cpp)
   // Scratch of one application (the preconditioner's solve is const in Eigen's interface).
   mutable Eigen::VectorXd residual, coarse_rhs, coarse_solution, coarse_work;
+  // The deflated team CG's t = A·D⁻¹·r (implicit_team_cg.cpp), 3 per unknown.
+  std::vector<double> smoothed_product;
 };
 
 namespace implicit_detail {
@@ -202,6 +204,15 @@ void update_deflation(ImplicitCache& cache);
 void apply_deflation(const ImplicitCache& cache, const double* r, double* z);
 // Deflation's CG must start with P₀ᵀ·r₀ = 0: x₀ += P₀·E⁻¹·P₀ᵀ·(b − A·x₀) (system.guess).
 void deflate_guess(ImplicitCache& cache);
+// The deflated team CG's coarse step (implicit_team_cg.cpp), serial between its phases: e =
+// E⁻¹·P₀ᵀ·t into state.coarse_solution, the restriction summed over the unknowns in index order
+// (fixed, whoever runs it). With r: returns (P₀ᵀ·r)·e, what r·z₁ must lose to be r·z for
+// z = z₁ − P₀·e. Nothing (and 0) without a coarse factor.
+double deflation_coarse_step(const ImplicitCache& cache, const double* t, const double* r);
+// Rows [begin, end): y += y_sign·P₀·e and ay −= (A·P₀)·e, e = state.coarse_solution; nothing
+// without a coarse factor. Row-local: chunks of rows run on any thread with the same bits.
+void add_coarse_correction(const PreconditionerState& state, uint32_t begin, uint32_t end,
+                           double y_sign, double* y, double* ay);
 
 // An even number of chunks of about target_rows rows each (at least one): a PhasedTeam's two
 // threads start from opposite ends and meet in the middle with equal shares.
@@ -211,9 +222,10 @@ inline uint32_t even_chunk_count(uint32_t rows, uint32_t target_rows) {
   return chunks > 1 && chunks % 2 == 1 ? chunks + 1 : chunks;
 }
 
-// Whether the preconditioner acts row by row (Jacobi, block-Jacobi): then the solve runs as the
-// row-chunked CG below, else as Eigen's.
-bool row_local_preconditioner(Preconditioner p);
+// Whether the step's solve runs on its team with the matrix-free operator: the row-local
+// preconditioners (Jacobi, block-Jacobi) as solve_row_chunked, Deflation as solve_deflated_team;
+// the others (and the assembled operator) in Eigen's CG.
+bool team_cg_preconditioner(Preconditioner p);
 
 // Step 5 for a row-local preconditioner and the matrix-free operator: Eigen's preconditioned CG
 // (same iterates, same stopping rule, same iteration count), worked in chunks of
@@ -222,6 +234,14 @@ bool row_local_preconditioner(Preconditioner p);
 // p = z + β·p. Dot products are summed per chunk and the chunks in order, so the bits are the
 // same on any thread count (but not Eigen's, whose dot products sum in another order).
 void solve_row_chunked(ImplicitCache& cache, PhasedTeam& team);
+
+// Step 5 for Deflation and the matrix-free operator: the same CG as Eigen's on A-DEF2
+// (implicit_deflation.cpp: deflated first guess, z = (I − Q·A)·D⁻¹·r), on the team in row chunks.
+// Three phases an iteration: t = A·z₁ (z₁ = D⁻¹·r); z = z₁ − P₀·e and A·z = t − (A·P₀)·e, then
+// p and q; the updates of x and r and z₁. Between the first two, one thread restricts t and solves
+// E·e = P₀ᵀ·t (small: a few hundred rows). Sums per chunk, then in chunk order: the same bits on
+// any thread count.
+void solve_deflated_team(ImplicitCache& cache, PhasedTeam& team);
 
 // Matrix-free A over the cache's blocks (Eigen's documented matrix-free pattern: an EigenBase with
 // a custom GEMV product, specialised below).

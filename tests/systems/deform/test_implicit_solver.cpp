@@ -294,16 +294,17 @@ TEST(ImplicitSolver, StepsAreBitIdenticalOnOneAndTwoThreads) {
   }
 }
 
-// The row-chunked CG (Jacobi, block-Jacobi with the matrix-free operator) is Eigen's CG with its
-// vector sums taken in another order: on the same system, from the same guess, it takes the same
-// number of iterations (give or take rounding at the last one) and reaches the same answer, on one
-// thread or on a team of two.
+// The team CGs (Jacobi, block-Jacobi, deflation with the matrix-free operator) are Eigen's CG with
+// their vector sums taken in another order: on the same system, from the same guess, they take the
+// same number of iterations (give or take rounding at the last one) and reach the same answer, on
+// one thread or on a team of two.
 TEST(ImplicitSolver, RowChunkedCgFollowsEigensCg) {
   Body b = implicit_test::make_capsule(1, 2000.0, 0.02);
   b.dynamics.gravity_mm_s2 = {0.0f, 0.0f, -9810.0f};
   ImplicitCache cache = assembled(b);
   ASSERT_GT(cache.pattern.rows(), 1000u);
-  for (Preconditioner p : {Preconditioner::Jacobi, Preconditioner::BlockJacobi}) {
+  for (Preconditioner p :
+       {Preconditioner::Jacobi, Preconditioner::BlockJacobi, Preconditioner::Deflation}) {
     SCOPED_TRACE(std::string(deform::to_string(p)));
     cache.settings.cg_operator = deform::CgOperator::Assembled;  // Eigen's CG
     deform::implicit_detail::write_matrix_pattern(cache.pattern, cache.system.matrix);
@@ -330,15 +331,18 @@ TEST(ImplicitSolver, RowChunkedCgFollowsEigensCg) {
   }
 }
 
-// The iteration limit stops the row-chunked CG where Eigen's stops, and says it did not converge.
+// The iteration limit stops the team CGs where Eigen's stops, and says they did not converge.
 TEST(ImplicitSolver, RowChunkedCgStopsAtTheIterationLimit) {
-  Body b = stiff_membrane(21);
-  ImplicitCache cache = assembled(b);
-  cache.settings.cg_max_iterations = 5;
-  const Solved s = solve_from_zero(cache, Preconditioner::BlockJacobi);
-  EXPECT_EQ(s.iterations, 5);
-  EXPECT_FALSE(s.converged);
-  EXPECT_TRUE(s.dv.allFinite());
+  for (Preconditioner p : {Preconditioner::BlockJacobi, Preconditioner::Deflation}) {
+    SCOPED_TRACE(std::string(deform::to_string(p)));
+    Body b = stiff_membrane(21);
+    ImplicitCache cache = assembled(b);
+    cache.settings.cg_max_iterations = 5;
+    const Solved s = solve_from_zero(cache, p);
+    EXPECT_EQ(s.iterations, 5);
+    EXPECT_FALSE(s.converged);
+    EXPECT_TRUE(s.dv.allFinite());
+  }
 }
 
 // A cut appends particles: the per-particle arrays grow, the unknown set and its pattern stay,
