@@ -39,11 +39,12 @@
 // form it measured 2.2–3.4× faster per step at levels 0–5, docs/implicit_and_active.md). The
 // matrix-free product gathers each row in a fixed order, so rows split over threads with the same
 // bits on any thread count.
-// Threads: the row-local preconditioners (Jacobi, block-Jacobi) with the matrix-free operator run
-// the step's assembly and a row-chunked CG on a team of two threads (implicit_team_cg.cpp,
+// Threads: Jacobi, block-Jacobi and deflation with the matrix-free operator run the step's
+// assembly and a row-chunked CG on a team of two threads (implicit_team_cg.cpp,
 // engine/schedule/phased_team.hpp), formed before the assembly so that its worker is awake when
-// the CG starts; the other preconditioners and the assembled operator use Eigen's
-// ConjugateGradient, whose product runs on several threads above settings.parallel_min_unknowns.
+// the CG starts (deflation's small coarse solve runs on one thread between two phases); the other
+// preconditioners and the assembled operator use Eigen's ConjugateGradient, whose product runs on
+// several threads above settings.parallel_min_unknowns.
 // Every sum has a fixed order, so 1 and 2 threads give the same bits. Eigen's CG allocates its
 // four work vectors per solve, the factored preconditioners when they are rebuilt; the
 // row-chunked CG keeps its work vectors in the cache (CgWork) and reuses them.
@@ -107,8 +108,9 @@ struct ImplicitSettings {
   bool warm_start = true;
   CgOperator cg_operator =
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
-  // Block-Jacobi: Deflation needs ≤ 40 CG iterations per frame at about its cost on one thread,
-  // but runs in Eigen's CG on one thread, where block-Jacobi's runs on the step's team of two
+  // Block-Jacobi. Deflation needs ≤ 40 CG iterations per frame and runs on the team too, but its
+  // cost against block-Jacobi's is not yet measured on an idle machine, and the level-1 expert's
+  // rhexis closes or not with rounding-level differences of either solve
   // (docs/implicit_and_active.md).
   Preconditioner preconditioner = Preconditioner::BlockJacobi;
   // The matrix-free product and the block preconditioners split their rows over threads from this
