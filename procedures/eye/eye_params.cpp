@@ -75,11 +75,11 @@ const std::vector<EyeParamRange>& eye_param_ranges() {
       {"capsule_model.grasp_radius_mm", 0.01, 3},
       {"lens_model.ultrasound_power", 0.01, 1},  // a fraction of full power (lens_sculpting)
       {"lens_model.damping_torque_mn_mm", 1e-4, 100},
-      {"lens_model.push_force_per_mm_mn_mm", 0.01, 1e4},
-      {"lens_model.nucleus_hardness", 0.05, 1},      // as the difficulty setting (docs/drills.md)
-      {"lens_model.vacuum_limit_mmhg", 50, 700},     // phaco machines: up to ~650 mmHg
-      {"lens_model.aspiration_flow_ml_min", 5, 60},  // peristaltic pumps: 20-40 mL/min
-      {"lens_model.crack_strength_mn", 1, 500},      // crack force at hardness 1 (nucleus_removal)
+      {"lens_model.bag_damping_mn_mm_s", 1e-3, 1e4},  // viscous damping of the bag (lens_sculpting)
+      {"lens_model.nucleus_hardness", 0.05, 1},       // as the difficulty setting (docs/drills.md)
+      {"lens_model.vacuum_limit_mmhg", 50, 700},      // phaco machines: up to ~650 mmHg
+      {"lens_model.aspiration_flow_ml_min", 5, 60},   // peristaltic pumps: 20-40 mL/min
+      {"lens_model.crack_strength_mn", 1, 500},       // crack force at hardness 1 (nucleus_removal)
       {"haptic_model.active_hops", 1, 64},
       {"haptic_model.contact_radius_mm", 0.05, 10},
       {"haptic_model.lens_stiffness_mn_mm", 0.1, 1e4},

@@ -22,9 +22,9 @@ Vec3 rotate_z(const Vec3& p, double angle) {
   return {c * p.x() - s * p.y(), s * p.x() + c * p.y(), p.z()};
 }
 
-// Does the probe's tip sphere touch an alive tet? (The push needs contact; the seed's centre test
-// with the tip's own radius, or the exact test when that is the scene's narrowphase.)
-bool tip_touches_lens(LensSculpting& ls, const Vec3& tip_local, double radius) {
+// The alive tets' centres in the probe's tip sphere (lens frame): the trench wall the tip meets.
+// Centres, as the seed's sculpting test (§5.3): the wall is where the sculpting stopped.
+void wall_in_tip(LensSculpting& ls, const Vec3& tip_local, double radius) {
   const sculpt::TipCapsule tip{tip_local, tip_local, radius};
   auto& cand = ls.sculpt.candidates;
   cand.clear();
@@ -35,12 +35,18 @@ bool tip_touches_lens(LensSculpting& ls, const Vec3& tip_local, double radius) {
   } else {
     ls.sculpt.dbvt.candidates(ls.topology, tip, cand, stats);
   }
+  ls.wall.clear();
+  const double r2 = radius * radius;
   for (uint32_t t : cand) {
-    if (ls.topology.alive[t] &&
-        sculpt::narrowphase_hit(ls.topology, ls.rest, t, tip, ls.sculpt.options.narrowphase))
-      return true;
+    if (!ls.topology.alive[t]) continue;
+    const Vec3 c = sculpt::tet_centre(ls.topology, t);
+    if ((c - tip_local).squaredNorm() < r2) ls.wall.push_back(c);
   }
-  return false;
+}
+
+// The probe's angle about the optical axis (world), rad.
+double probe_azimuth(const Vec3& p) {
+  return std::atan2(p.y(), p.x());
 }
 
 // The scene's lens particles: the rest vertices turned by the nucleus angle.
@@ -86,8 +92,8 @@ void add_lens_sculpting(Scene& scene) {
   const double lens_mass = volume * params.get("lens.density_kg_m3") * kKgPerMm3PerKgPerM3;
   ls.rotation =
       nucleus::make_rotation(centres, lens_mass / std::max<uint32_t>(1, ls.topology.tet_count));
-  ls.push.damping_torque = params.get("lens_model.damping_torque_mn_mm");
-  ls.push.force_per_mm = params.get("lens_model.push_force_per_mm_mn_mm");
+  ls.push.friction_torque = params.get("lens_model.damping_torque_mn_mm");
+  ls.push.damping = params.get("lens_model.bag_damping_mn_mm_s");
   ls.ultrasound_power = params.get("lens_model.ultrasound_power");
   if (ls.ultrasound_power > 1.0) {
     throw InputError(scene.scenario.source +
@@ -115,6 +121,9 @@ SystemDesc lens_sculpt_system(Scene& scene) {
           .writes = {"lens.tets", "lens.particles", "lens.sculpting"},
           .run = [&scene, lens](const FrameContext& ctx) {
             LensSculpting& ls = scene.world.at<LensSculpting>(lens);
+            const double angle0 = ls.rotation.angle_rad;
+            // The bag's friction and damping first: what the nucleus turns on its own this step.
+            const double free_turn = nucleus::free_rotation_step(ls.rotation, ls.push, ctx.dt_s);
             for (Entity e : scene.tools) {
               if (scene.world.at<Tool>(e).kind != ToolKind::PhacoProbe) continue;
               const ToolState& tool = scene.world.at<ToolState>(e);
@@ -124,7 +133,7 @@ SystemDesc lens_sculpt_system(Scene& scene) {
                 if (!ls.ultrasound_was_on) ++ls.strokes, ls.previous_tip.reset();
                 ls.ultrasound_was_on = true;
                 ls.ultrasound_time_s += ctx.dt_s;
-                ls.previous_contact.reset();
+                ls.previous_probe.reset();
                 const auto t0 = std::chrono::steady_clock::now();
                 const auto removed = sculpt::sculpt_step(
                     ls.topology, ls.rest, ls.sculpt, {tip, ls.previous_tip.value_or(tip), radius});
@@ -152,20 +161,30 @@ SystemDesc lens_sculpt_system(Scene& scene) {
               }
               ls.ultrasound_was_on = false;
               ls.previous_tip.reset();
-              // No ultrasound: a probe touching the lens pushes it round the optical axis.
-              if (!tip_touches_lens(ls, tip, sculpt::kPhacoTipRadiusMm)) {
-                ls.previous_contact.reset();
-                continue;
+              // No ultrasound: the tip pushes the trench wall ahead of it, which cannot pass it
+              // (systems/nucleus/rotation.hpp): the nucleus turns by the least angle that keeps
+              // the wall at the tip, at most the tip's own travel about the axis relative to it.
+              const double rho = std::hypot(tool.pos.x(), tool.pos.y());
+              if (ls.previous_probe && rho > sculpt::kPhacoTipRadiusMm) {
+                const double travel =
+                    std::remainder(probe_azimuth(tool.pos) - probe_azimuth(*ls.previous_probe),
+                                   2 * std::numbers::pi) -
+                    free_turn;
+                const int sign = travel > 0 ? 1 : travel < 0 ? -1 : 0;
+                if (sign != 0) {
+                  wall_in_tip(ls, tip, sculpt::kPhacoTipRadiusMm);
+                  const double need =
+                      nucleus::wall_clearance_angle(ls.wall, tip, sculpt::kPhacoTipRadiusMm, sign);
+                  const double turn = std::min(need, std::abs(travel));
+                  if (turn > 0) {
+                    nucleus::contact_rotation_step(ls.rotation, turn, sign, ctx.dt_s);
+                    ++ls.push_frames;
+                  }
+                }
               }
-              if (ls.previous_contact) {
-                const double torque = nucleus::applied_torque(
-                    ls.rotation.axis, *ls.previous_contact, tool.pos, ls.push);
-                const double theta = nucleus::rotation_step(ls.rotation, torque, ls.push, ctx.dt_s);
-                if (theta != 0.0) place_lens(ls, scene.world.at<Particles>(lens));
-                ++ls.push_frames;
-              }
-              ls.previous_contact = tool.pos;
+              ls.previous_probe = tool.pos;
             }
+            if (ls.rotation.angle_rad != angle0) place_lens(ls, scene.world.at<Particles>(lens));
           }};
 }
 
@@ -199,6 +218,7 @@ nlohmann::json lens_sculpting_summary(Scene& scene) {
   j["nucleus_inertia_kg_mm2"] = ls->rotation.inertia;
   j["nucleus_inertia0_kg_mm2"] = ls->rotation.inertia0;
   j["push_frames"] = ls->push_frames;
+  j["nucleus_push_torque_max_mn_mm"] = ls->rotation.contact_torque_max;
   const lens::TrenchReport trenches = lens::measure_trenches(ls->removed, ls->nucleus);
   j["trench_count"] = trenches.trenches.size();
   j["trench_crossing_angle_deg"] = trenches.crossing_angle_deg;

@@ -8,16 +8,16 @@
 //     into the lens frame, sculpts — systems/sculpt removes the tets it sweeps (broadphase on the
 //     first contact, then a walk over face neighbours from the last removals) and keeps the surface
 //     list; the nucleus's moment of inertia loses m·r² per removed tet;
-//   - ultrasound off, tip touching the lens: the probe pushes the nucleus round (seed 000 §5.4):
-//     force linear in the contact point's travel since the last frame, torque about the axis
-//     against a constant damping torque, θ = ½·α·Δt² (quasi-static).
+//   - ultrasound off: the tip pushes the trench wall ahead of it round the optical axis, a
+//     kinematic contact against the bag's friction and damping (systems/nucleus/rotation.hpp):
+//     the wall cannot pass the tip, and the tip cannot throw the nucleus.
 // Removed tets are kept with the stroke (a continuous period of ultrasound) that removed them, for
 // the trench measures (procedures/lens/trench_measure).
 //
 // Methods (scenario `methods`): lens.broadphase octree | dbvt (default octree);
 // lens.narrowphase centre | exact_gjk | exact_mpr (default centre, the seed's test).
-// Parameters (eye file, lens_model.*): ultrasound_power (0..1], damping_torque_mn_mm,
-// push_force_per_mm_mn_mm.
+// Parameters (eye file, lens_model.*): ultrasound_power (0..1], damping_torque_mn_mm (the bag's
+// Coulomb friction), bag_damping_mn_mm_s (its viscous damping).
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -45,8 +45,9 @@ struct LensSculpting {
   nucleus::RotationSettings push;
   double ultrasound_power = 1.0;
   lens::NucleusShape nucleus;
-  std::optional<Vec3> previous_tip;      // lens frame, last frame with ultrasound on
-  std::optional<Vec3> previous_contact;  // world, last frame the probe pushed the lens
+  std::optional<Vec3> previous_tip;    // lens frame, last frame with ultrasound on
+  std::optional<Vec3> previous_probe;  // world, last frame without ultrasound
+  std::vector<Vec3> wall;              // scratch: alive tet centres in the tip's sphere
   bool ultrasound_was_on = false;
   uint32_t strokes = 0;
   std::vector<lens::RemovedElement> removed;  // rest centre, volume, stroke of every removed tet

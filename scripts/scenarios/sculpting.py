@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """Writes a scripted divide-and-conquer scenario (phaco sculpting).
 
-usage: sculpting.py OUT.json [--passes 0.8,1.5,2.2,2.65] [--lanes -0.35,0.35] [--name N] [--description D]
+usage: sculpting.py OUT.json [--passes 0.4,1.15,1.9,2.65] [--lanes -0.35,0.35] [--name N] [--description D]
 
 The phaco probe enters through the temporal incision, sculpts a trench in passes of increasing
 depth (mm below the anterior lens surface at the centre), one pass per lane, turns the nucleus a
 quarter turn with the tip in the trench (pedal 1) and sculpts the second trench the same way.
-The defaults are data/scenarios/phaco_sculpting_demo.json (the expert). The probe pivots in the
+The defaults are the expert's (make_all.sh). The first pass shaves the surface, 0.4 mm down, so the
+trench is an open groove in the microscope view (issue 19); data/scenarios/phaco_sculpting_demo.json
+is the older roofed trench (--passes 0.8,1.5,2.2,2.65: its top layer stays). The probe pivots in the
 main corneal port (scripts/scenarios/ports.py): its shaft passes through the port's centre in
 every sample, and it rests 0.25 mm inside that centre on the tunnel's axis.
 """
@@ -14,7 +16,7 @@ import argparse, json, math
 import ports
 ap = argparse.ArgumentParser()
 ap.add_argument("out")
-ap.add_argument("--passes", default="0.8,1.5,2.2,2.65")
+ap.add_argument("--passes", default="0.4,1.15,1.9,2.65")
 ap.add_argument("--lanes", default="-0.35,0.35")
 ap.add_argument("--name", default="phaco sculpting demo")
 ap.add_argument("--description", default="Divide and conquer: the phaco probe through the temporal incision sculpts a trench in four passes of increasing depth, two lanes each (pedal 3), rotates the nucleus a quarter turn with the tip in the trench (pedal 1), and sculpts the second trench the same way.")
@@ -54,7 +56,8 @@ def trench_pass(depth, y):
         add(2.0 / n if k else 0.2, (x, y, lens_top(x, y) - depth * (1 - 0.4 * (x / 2.3) ** 2)), 3)
     add(0.3, (x1, y, 2.3), 1)
 # Four passes of increasing depth, each in two lanes 0.7 mm apart: a trench about 1.6 mm wide
-# (1.5-2 tip diameters) and 80 % of the nucleus deep at the centre.
+# (1.5-2 tip diameters) and 80 % of the nucleus deep at the centre. The first pass takes the top
+# layer off (0.4 mm down: the tip's sphere reaches the surface), so the groove is open.
 passes = [float(v) for v in args.passes.split(",")]
 lanes = [float(v) for v in args.lanes.split(",")]
 def trench():
@@ -62,7 +65,9 @@ def trench():
         for y in lanes: trench_pass(d, y)
 trench()
 # Rotation: pedal 1 (no ultrasound), the tip in the first trench at 1.5 mm from the axis, pushed
-# round the axis a quarter turn; the nucleus follows as far as the seed's torque law lets it.
+# round the axis a quarter turn and 0.22 rad more: the tip first crosses the trench's free play
+# (about 0.35 mm at the tip's height, 13 deg at 1.5 mm), then pushes its wall (a kinematic
+# contact, systems/nucleus/rotation.hpp).
 r, z = 1.5, 0.4
 add(0.6, (-r, 0, 2.3), 1)
 add(0.4, (-r, 0, z), 1)

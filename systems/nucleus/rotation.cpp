@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <numbers>
 
 #include "engine/core/invariants.hpp"
 #include "engine/schedule/parallel.hpp"
@@ -52,24 +53,52 @@ void remove_tets(NucleusRotation& state, std::span<const Vec3> removed_centres) 
   state.inertia = std::max(state.inertia0 - state.tet_mass_kg * state.removed_sum_r2, 0.0);
 }
 
-double applied_torque(const Axis& axis, const Vec3& prev_contact, const Vec3& contact,
-                      const RotationSettings& s) {
-  const Vec3 force = s.force_per_mm * (contact - prev_contact);
-  return (contact - axis.point).cross(force).dot(unit_direction(axis));
-}
-
-double angular_acceleration(double torque, double damping_torque, double inertia) {
-  const double td = std::abs(damping_torque);
-  if (!(inertia > 0) || !(std::abs(torque) > td)) return 0;
-  return (torque - std::copysign(td, torque)) / inertia;
-}
-
-double rotation_step(NucleusRotation& state, double torque, const RotationSettings& s,
-                     double dt_s) {
-  const double alpha = angular_acceleration(torque, s.damping_torque, state.inertia);
-  const double theta = 0.5 * alpha * dt_s * dt_s;
+double free_rotation_step(NucleusRotation& state, const RotationSettings& s, double dt_s) {
+  if (!(state.inertia > 0)) {
+    state.angular_velocity = 0;
+    return 0;
+  }
+  // Viscous damping implicitly (stable for any c Δt / I), then Coulomb friction that may stop
+  // the nucleus but never turn it back.
+  double w = state.angular_velocity / (1.0 + s.damping * dt_s / state.inertia);
+  const double stop = s.friction_torque * dt_s / state.inertia;
+  w = std::abs(w) <= stop ? 0.0 : w - std::copysign(stop, w);
+  state.angular_velocity = w;
+  const double theta = w * dt_s;
   state.angle_rad += theta;
   return theta;
+}
+
+double wall_clearance_angle(std::span<const Vec3> wall_points, const Vec3& tip, double radius,
+                            int sign) {
+  const double rho_t = std::hypot(tip.x(), tip.y());
+  if (!(rho_t > 0) || sign == 0) return 0;
+  const double phi_t = std::atan2(tip.y(), tip.x());
+  const double s = sign > 0 ? 1.0 : -1.0;
+  double need = 0;
+  for (const Vec3& p : wall_points) {
+    const double rho = std::hypot(p.x(), p.y());
+    if (!(rho > 0)) continue;
+    const double dz = p.z() - tip.z();
+    // The point's circle about the axis is inside the sphere for |ψ| < ψmax (law of cosines).
+    const double c = (rho_t * rho_t + rho * rho + dz * dz - radius * radius) / (2 * rho_t * rho);
+    if (c >= 1) continue;  // the circle misses the sphere
+    const double psi_max = std::acos(std::max(c, -1.0));
+    const double psi = std::remainder(std::atan2(p.y(), p.x()) - phi_t, 2 * std::numbers::pi) * s;
+    if (!(psi > 0)) continue;  // behind the tip: the tip moves away from it
+    need = std::max(need, psi_max - psi);
+  }
+  return need;
+}
+
+double contact_rotation_step(NucleusRotation& state, double clearance_rad, int sign, double dt_s) {
+  if (!(clearance_rad > 0) || sign == 0 || !(state.inertia > 0) || !(dt_s > 0)) return 0;
+  const double turn = sign > 0 ? clearance_rad : -clearance_rad;
+  state.angle_rad += turn;
+  state.angular_velocity += turn / dt_s;
+  const double torque = state.inertia * clearance_rad / (dt_s * dt_s);
+  state.contact_torque_max = std::max(state.contact_torque_max, torque);
+  return torque;
 }
 
 void rotate_about_axis(std::span<float> x, std::span<float> y, std::span<float> z, const Axis& axis,

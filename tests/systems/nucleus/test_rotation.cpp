@@ -1,4 +1,4 @@
-// Nucleus rotation about the optical axis (seed 000 §5.4).
+// Nucleus rotation about the optical axis (seed 000 §5.4; the push a kinematic contact, issue 19).
 #include <gtest/gtest.h>
 #include <oneapi/tbb/task_arena.h>
 
@@ -46,49 +46,85 @@ TEST(NucleusRotation, RemovingTetsLowersInertiaByExactlyMassTimesSquaredDistance
   // Removing everything leaves nothing to turn.
   remove_tets(s, grid_centres());
   EXPECT_EQ(s.inertia, 0.0);
-  EXPECT_EQ(rotation_step(s, 100.0, RotationSettings{}, 0.01), 0.0);
+  EXPECT_EQ(contact_rotation_step(s, 0.1, 1, 0.01), 0.0);
 }
 
-TEST(NucleusRotation, TorqueFromTangentialProbeMotionOnly) {
-  const Axis axis;
-  RotationSettings s;
-  s.force_per_mm = 3.0;
-  // At radius 2 on +x, moving 0.1 mm along +y: F = 0.3 mN along +y, T = 2 × 0.3 = 0.6 mN·mm.
-  EXPECT_NEAR(applied_torque(axis, Vec3(2, 0, 1), Vec3(2, 0.1, 1), s), 0.6, 1e-12);
-  EXPECT_NEAR(applied_torque(axis, Vec3(2, 0, 1), Vec3(2, -0.1, 1), s), -0.6, 1e-12);
-  EXPECT_NEAR(applied_torque(axis, Vec3(2, 0, 1), Vec3(2.3, 0, 0.5), s), 0.0,
-              1e-12);  // radial, axial
-}
-
-TEST(NucleusRotation, NoRotationBelowTheDampingTorque) {
+// The bag's friction and damping (systems/nucleus/rotation.hpp, step 1).
+TEST(NucleusRotation, TheBagDampsAndStopsAFreeNucleusWithoutTurningItBack) {
   NucleusRotation state = make_rotation(grid_centres(), 0.5);
+  const double inertia = state.inertia, dt = 1.0 / 120;
   RotationSettings s;
-  s.damping_torque = 0.5;
-  EXPECT_EQ(rotation_step(state, 0.5, s, 0.01), 0.0);
-  EXPECT_EQ(rotation_step(state, -0.49, s, 0.01), 0.0);
-  EXPECT_EQ(angular_acceleration(0.3, 0.5, state.inertia), 0.0);
-  EXPECT_EQ(state.angle_rad, 0.0);
+  s.friction_torque = 0;
+  s.damping = inertia;  // c Δt / I = Δt: ω decays by 1 / (1 + Δt) a step (implicit)
+  state.angular_velocity = 2.0;
+  EXPECT_DOUBLE_EQ(free_rotation_step(state, s, dt), 2.0 / (1 + dt) * dt);
+  EXPECT_DOUBLE_EQ(state.angular_velocity, 2.0 / (1 + dt));
+  // Coulomb friction alone: ω falls by T_f Δt / I a step, then sticks at zero.
+  s.damping = 0;
+  s.friction_torque = 0.5 * state.angular_velocity * inertia / dt;  // stops it in two steps
+  const double w0 = state.angular_velocity;
+  free_rotation_step(state, s, dt);
+  EXPECT_NEAR(state.angular_velocity, 0.5 * w0, 1e-12);
+  free_rotation_step(state, s, dt);
+  EXPECT_NEAR(state.angular_velocity, 0.0, 1e-12);
+  const double stopped = state.angle_rad;
+  EXPECT_EQ(free_rotation_step(state, s, dt), 0.0) << "friction never turns it back";
+  EXPECT_EQ(state.angle_rad, stopped);
+  // A stiff viscous bag (c Δt / I ≫ 1, the standard eye) stops it within a step.
+  state.angular_velocity = 1.0;
+  s = RotationSettings{0.0, 1000 * inertia / dt};
+  free_rotation_step(state, s, dt);
+  EXPECT_LT(std::abs(state.angular_velocity), 1e-3);
+  // Nothing left to turn.
+  remove_tets(state, grid_centres());
+  state.angular_velocity = 1.0;
+  EXPECT_EQ(free_rotation_step(state, RotationSettings{}, dt), 0.0);
+  EXPECT_EQ(state.angular_velocity, 0.0);
 }
 
-TEST(NucleusRotation, AngleIsHalfAlphaDtSquaredWithDampingOpposingTheTorque) {
+// The wall cannot pass the tip (step 2): after the clearance turn, the nearest wall point is on
+// the tip's sphere, exactly.
+TEST(NucleusRotation, ClearanceTurnPutsTheWallOnTheTipsSphere) {
+  const Vec3 tip(2.0, 0.0, 0.5);
+  const double r = 0.45;
+  // A point on the tip's circle about the axis, 0.1 rad ahead (counter-clockwise): inside the
+  // sphere (chord 0.2 mm). It must end where the chord is r: ψ = 2 asin(r / (2ρ)).
+  const std::vector<Vec3> one = {Vec3(2 * std::cos(0.1), 2 * std::sin(0.1), 0.5)};
+  const double psi_max = 2 * std::asin(r / 4.0);
+  EXPECT_NEAR(wall_clearance_angle(one, tip, r, +1), psi_max - 0.1, 1e-12);
+  EXPECT_EQ(wall_clearance_angle(one, tip, r, -1), 0.0) << "behind a clockwise push";
+  std::vector<Vec3> turned = one;
+  rotate_about_axis(turned, Axis{}, psi_max - 0.1);
+  EXPECT_NEAR((turned[0] - tip).norm(), r, 1e-12);
+  // Mirrored: the same point below the x axis asks the same clockwise.
+  const std::vector<Vec3> mirrored = {Vec3(one[0].x(), -one[0].y(), 0.5)};
+  EXPECT_NEAR(wall_clearance_angle(mirrored, tip, r, -1), psi_max - 0.1, 1e-12);
+  // Off the tip's circle (other radius and height): the turn still ends on the sphere.
+  const std::vector<Vec3> off = {Vec3(2.2, 0.15, 0.3), Vec3(1.9, 0.05, 0.7), Vec3(2.0, 0.6, 0.5),
+                                 Vec3(2.0, -0.1, 0.5)};  // the last two: outside, behind
+  const double turn = wall_clearance_angle(off, tip, r, +1);
+  ASSERT_GT(turn, 0.0);
+  std::vector<Vec3> inside(off.begin(), off.begin() + 2);
+  rotate_about_axis(inside, Axis{}, turn);
+  EXPECT_NEAR(std::min((inside[0] - tip).norm(), (inside[1] - tip).norm()), r, 1e-9);
+  EXPECT_GE(std::max((inside[0] - tip).norm(), (inside[1] - tip).norm()), r - 1e-9);
+  // Points outside the sphere ask nothing; a tip on the axis cannot push.
+  const std::vector<Vec3> outside = {Vec3(2.0, 0.6, 0.5), Vec3(2.0, 0.0, 1.5)};
+  EXPECT_EQ(wall_clearance_angle(outside, tip, r, +1), 0.0);
+  EXPECT_EQ(wall_clearance_angle(one, Vec3(0, 0, 0.5), r, +1), 0.0);
+}
+
+TEST(NucleusRotation, ContactTurnSetsTheAngularVelocityAndTheWallsTorque) {
   NucleusRotation state = make_rotation(grid_centres(), 0.5);
-  RotationSettings s;
-  s.damping_torque = 0.5;
-  const double dt = 1.0 / 120, inertia = state.inertia;
-  const double alpha = (2.0 - 0.5) / inertia;
-  EXPECT_EQ(angular_acceleration(2.0, 0.5, inertia), alpha);
-  EXPECT_EQ(rotation_step(state, 2.0, s, dt), 0.5 * alpha * dt * dt);
-  EXPECT_EQ(rotation_step(state, -2.0, s, dt), -0.5 * alpha * dt * dt);  // T_d opposes T
-  EXPECT_EQ(state.angle_rad, 0.0);
-  // Quasi-static: the same torque twice turns twice as far, no carried angular velocity.
-  rotation_step(state, 2.0, s, dt);
-  rotation_step(state, 2.0, s, dt);
-  EXPECT_DOUBLE_EQ(state.angle_rad, alpha * dt * dt);
-  // A lighter nucleus (tets removed) turns further under the same torque.
-  NucleusRotation light = make_rotation(grid_centres(), 0.5);
-  const std::vector<Vec3> gone = {Vec3(3, 2, 0), Vec3(-3, -2, 0)};
-  remove_tets(light, gone);
-  EXPECT_GT(rotation_step(light, 2.0, s, dt), 0.5 * alpha * dt * dt);
+  const double dt = 1.0 / 120;
+  const double torque = contact_rotation_step(state, 0.01, -1, dt);
+  EXPECT_DOUBLE_EQ(state.angle_rad, -0.01);
+  EXPECT_DOUBLE_EQ(state.angular_velocity, -0.01 / dt);
+  EXPECT_DOUBLE_EQ(torque, state.inertia * 0.01 / (dt * dt));
+  EXPECT_DOUBLE_EQ(state.contact_torque_max, torque);
+  EXPECT_EQ(contact_rotation_step(state, 0.0, 1, dt), 0.0);
+  EXPECT_EQ(contact_rotation_step(state, 0.01, 0, dt), 0.0);
+  EXPECT_DOUBLE_EQ(state.angle_rad, -0.01);
 }
 
 TEST(NucleusRotation, RotationKeepsDistanceToTheAxisAndTurnsByTheta) {
