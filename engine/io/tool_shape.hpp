@@ -6,7 +6,8 @@
 // 1 mm. The drawn instrument (engine/render/procedural), the pivot in a port
 // (procedures/scene/port_pivot), the ports' equilibrium and metrics (systems/tool_eye,
 // procedures/scene/tool_ports), the port a haptic device feels (systems/haptic_model) and the
-// shaft pressing the rhexis rim (procedures/scene/rim_tear) all take the shaft from here, so they cannot disagree on where it passes.
+// shaft pressing the rhexis rim (procedures/scene/rim_tear) all take the shaft from here, so they
+// cannot disagree on where it passes.
 #include "engine/core/math.hpp"
 #include "engine/io/scenario.hpp"
 #include "engine/io/track.hpp"
