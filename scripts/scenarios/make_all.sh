@@ -16,7 +16,7 @@ rhexis "$out/capsulorhexis_novice_runout.json" --scale 1.04 --outward 5.3,6.5,0.
 rhexis "$out/capsulorhexis_novice_small.json" --scale 0.9 --name "capsulorhexis novice: too small" \
   --description "The demo's technique at a 4.4 mm circle: complete and round but too small."
 sculpt "$out/phaco_sculpting_expert.json" --name "phaco sculpting expert" \
-  --description "Divide and conquer as the demo: two trenches of four passes, two lanes each, a quarter turn between them."
+  --description "Divide and conquer: two trenches of four passes, two lanes each, the first pass shaving the surface so that each trench is an open groove; a quarter turn between them."
 sculpt "$out/phaco_sculpting_novice_shallow.json" --passes 0.8,1.5 --name "phaco sculpting novice: shallow trenches" \
   --description "Only the first two passes of each trench: the trenches are about 40 % of the nucleus deep."
 sculpt "$out/phaco_sculpting_novice_narrow.json" --lanes 0 --name "phaco sculpting novice: narrow trenches" \
