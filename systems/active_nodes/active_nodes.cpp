@@ -5,9 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "engine/core/radix_sort.hpp"
-#include "engine/schedule/phased_team.hpp"
-
 namespace phaco::active_nodes {
 
 namespace {
@@ -37,19 +34,6 @@ double net_force_sq(const SpringGraph& g, const WakeInputs& w, uint32_t p) {
   return fx * fx + fy * fy + fz * fz;
 }
 
-constexpr uint8_t kMoved = 1, kLoaded = 2;
-
-// Particles per chunk of the wake rules' force tests. A test walks the particle's springs (about
-// 6 on the capsule, ~40 ns each), so a chunk of 256 is ~10 µs: well above what a team's phase
-// costs (a few µs), while a level-3 set (~1000) still splits. Fewer particles: one chunk, no team.
-constexpr uint32_t kWakeGrain = 256;
-
-// An even number of chunks (the team's two threads start from opposite ends), fixed by the count.
-uint32_t wake_chunk_count(uint32_t count) {
-  const uint32_t chunks = std::max(1u, (count + kWakeGrain - 1) / kWakeGrain);
-  return chunks > 1 && chunks % 2 == 1 ? chunks + 1 : chunks;
-}
-
 }  // namespace
 
 void clear_active_set(ActiveSet& set) {
@@ -74,15 +58,10 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
     if (set.mark.capacity() < n) {
       set.mark.reserve(size_t{n} + n / 4 + 64);
       set.previous.reserve(size_t{n} + n / 4 + 64);
-      set.in_frontier.reserve(size_t{n} + n / 4 + 64);
     }
     set.mark.resize(n, 0);
     set.previous.resize(n, 0);
   }
-  if (set.in_frontier.size() != n) set.in_frontier.assign(n, 0);  // a set made before it existed
-  // The team for the wake rules, formed before the walk below so that its worker is awake when
-  // they start (phased_team.hpp); only when they will split.
-  PhasedTeam team(wake_chunk_count(static_cast<uint32_t>(set.particles.size())) > 1);
   // Last update's set becomes `previous`; marks are cleared through it.
   set.previous_list.assign(set.particles.begin(), set.particles.end());
   for (uint32_t p : set.previous_list) set.mark[p] = 0, set.previous[p] = 1;
@@ -112,13 +91,7 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
   set.particles.assign(set.queue.begin(), set.queue.end());
   const size_t ball = set.particles.size();
 
-  // Wake rules, evaluated on the previous set and its sleeping frontier. The force tests are most
-  // of the update's cost (a pass over each particle's springs); they are pure, so they run on the
-  // team in chunks, and the set they produce does not depend on the order they ran in:
-  //   phase 0   per particle p of the previous set: moved? loaded?            (wake_flags)
-  //   gate      activate those; list the sleeping frontier not yet active      (frontier)
-  //   phase 1   per frontier particle: loaded?                                 (frontier_flags)
-  //   after     activate the loaded frontier
+  // Wake rules, evaluated on the previous set and its sleeping frontier.
   const double motion_sq = wake.motion_threshold_mm * wake.motion_threshold_mm;
   const double load_sq = wake.force_threshold_mn * wake.force_threshold_mn;
   const bool force_rule = wake.particles && wake.springs;
@@ -127,59 +100,20 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
     set.mark[q] = 1;
     set.particles.push_back(q);
   };
-  const uint32_t previous_count = static_cast<uint32_t>(set.previous_list.size());
-  set.wake_flags.resize(previous_count);
-  set.frontier.clear();
-  const uint32_t chunks = wake_chunk_count(previous_count);
-  const auto in_chunk = [chunks](uint32_t count, uint32_t chunk, uint32_t& begin, uint32_t& end) {
-    const uint32_t per = (count + chunks - 1) / chunks;
-    begin = std::min(count, chunk * per), end = std::min(count, begin + per);
-  };
-  const auto gate = [&](uint64_t phase) {
-    if (phase == 0) return true;
-    for (uint32_t k = 0; k < previous_count; ++k) {
-      const uint32_t p = set.previous_list[k];
-      const bool moved = set.wake_flags[k] & kMoved;
-      if (set.wake_flags[k]) activate(p);
-      for (uint32_t e = graph.begin(p); e < graph.end(p); ++e) {
-        const uint32_t q = graph.neighbour[e];
-        if (moved) {
-          activate(q);
-        } else if (force_rule && !set.previous[q] && !set.mark[q] && !set.in_frontier[q]) {
-          set.in_frontier[q] = 1;  // tested once, however many active neighbours it has
-          set.frontier.push_back(q);
-        }
+  for (uint32_t p : set.previous_list) {
+    const bool moved =
+        wake.particles && speed_sq(*wake.particles, p) * wake.dt_s * wake.dt_s > motion_sq;
+    const bool loaded = force_rule && net_force_sq(graph, wake, p) > load_sq;
+    if (moved || loaded) activate(p);
+    for (uint32_t k = graph.begin(p); k < graph.end(p); ++k) {
+      const uint32_t q = graph.neighbour[k];
+      if (moved) {
+        activate(q);
+      } else if (force_rule && !set.previous[q] && !set.mark[q] &&
+                 net_force_sq(graph, wake, q) > load_sq) {
+        activate(q);  // sleeping frontier loaded by an active neighbour's springs
       }
     }
-    set.frontier_flags.resize(set.frontier.size());
-    return !set.frontier.empty();
-  };
-  const auto work = [&](uint64_t phase, uint32_t chunk) {
-    uint32_t begin = 0, end = 0;
-    if (phase == 0) {
-      in_chunk(previous_count, chunk, begin, end);
-      for (uint32_t k = begin; k < end; ++k) {
-        const uint32_t p = set.previous_list[k];
-        const bool moved =
-            wake.particles && speed_sq(*wake.particles, p) * wake.dt_s * wake.dt_s > motion_sq;
-        const bool loaded = force_rule && net_force_sq(graph, wake, p) > load_sq;
-        set.wake_flags[k] = uint8_t((moved ? kMoved : 0) | (loaded ? kLoaded : 0));
-      }
-    } else {
-      in_chunk(static_cast<uint32_t>(set.frontier.size()), chunk, begin, end);
-      for (uint32_t k = begin; k < end; ++k)
-        set.frontier_flags[k] = net_force_sq(graph, wake, set.frontier[k]) > load_sq;
-    }
-  };
-  if (chunks == 1) {  // below the grain: no team (phased_team.hpp), the same steps in order
-    work(0, 0);
-    if (gate(1)) work(1, 0);
-  } else {
-    team.run(chunks, 2, gate, work);
-  }
-  for (size_t k = 0; k < set.frontier.size(); ++k) {
-    if (set.frontier_flags[k]) activate(set.frontier[k]);
-    set.in_frontier[set.frontier[k]] = 0;
   }
   set.woken = static_cast<uint32_t>(set.particles.size() - ball);
 
@@ -187,7 +121,7 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
     if (!set.mark[p]) set.fell_asleep.push_back(p);
     set.previous[p] = 0;
   }
-  radix_sort_indices(set.particles, set.sort_scratch);
+  std::sort(set.particles.begin(), set.particles.end());
 
   // Each spring once: from its lower active end, or from its only active end. Half the entries
   // to sort of listing it from both ends and removing the duplicates.
@@ -197,7 +131,7 @@ void update_active_set(const SpringGraph& graph, std::span<const uint32_t> seeds
       const uint32_t q = graph.neighbour[k];
       if (q > p || !set.mark[q]) set.spring_scratch.push_back(graph.spring[k]);
     }
-  radix_sort_indices(set.spring_scratch, set.sort_scratch);
+  std::sort(set.spring_scratch.begin(), set.spring_scratch.end());
   const auto last = std::unique(set.spring_scratch.begin(), set.spring_scratch.end());
   set.springs.assign(set.spring_scratch.begin(), last);
 }

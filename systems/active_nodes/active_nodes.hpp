@@ -59,11 +59,7 @@ struct ActiveSet {
   // Scratch, sized to the particle count once; cleared through the lists above.
   std::vector<uint8_t> mark;      // 1 = active
   std::vector<uint8_t> previous;  // 1 = was active at the last update
-  std::vector<uint32_t> queue, hops, spring_scratch, previous_list, sort_scratch;
-  // The wake rules' force tests (active_nodes.cpp): per previous particle, moved | loaded; the
-  // sleeping frontier, tested once each (in_frontier: 1 = listed), and its results.
-  std::vector<uint8_t> wake_flags, frontier_flags, in_frontier;
-  std::vector<uint32_t> frontier;
+  std::vector<uint32_t> queue, hops, spring_scratch, previous_list;
 };
 
 // Recomputes `set` from the seeds' k-hop ball and the wake rules (see the top of this file).

@@ -1,7 +1,6 @@
 #include "systems/deform/guard.hpp"
 
 #include <cmath>
-#include <span>
 
 #include "systems/deform/particle_set.hpp"
 #include "systems/deform/spring_law.hpp"
@@ -72,16 +71,8 @@ Energy measure_energy(const Membrane& m) {
           return sum;
         },
         [](double a, double b) { return a + b; });
-  } else {  // the active springs, in the same fixed chunks (two energy passes per step)
-    const std::span<const uint32_t> springs = m.active_springs;
-    e.elastic = parallel_reduce_ordered(
-        0u, static_cast<uint32_t>(springs.size()), kSpringGrain, 0.0,
-        [&](uint32_t begin, uint32_t end) {
-          double sum = 0.0;
-          for (uint32_t k = begin; k < end; ++k) sum += spring_energy_of(m, springs[k]);
-          return sum;
-        },
-        [](double a, double b) { return a + b; });
+  } else {
+    for (const uint32_t s : m.active_springs) e.elastic += spring_energy_of(m, s);
   }
   for (const PointLoad& load : m.loads) {
     if (load.particle >= n || !finite3(load.fx, load.fy, load.fz)) continue;
@@ -160,27 +151,10 @@ uint32_t sanitize_and_save(Membrane& m, Snapshot& snap) {
     }
   }
   const ParticleSet set = particles_in_play(m);
-  // Sleeping ends are read by the spring pass: repair them too. Almost always all is finite, so
-  // the ends are checked in parallel chunks first (read only) and repaired in order only if not.
-  const std::span<const uint32_t> springs =
-      m.active.empty() ? std::span<const uint32_t>{} : m.active_springs;
-  const auto broken = [&p](uint32_t i) {
-    return !finite3(p.x[i], p.y[i], p.z[i]) || !finite3(p.vx[i], p.vy[i], p.vz[i]);
-  };
-  const bool any_broken_end = parallel_reduce_ordered(
-      0u, static_cast<uint32_t>(springs.size()), kSpringGrain, false,
-      [&](uint32_t begin, uint32_t end) {
-        bool found = false;
-        for (uint32_t k = begin; k < end; ++k)
-          found |= broken(m.springs.i[springs[k]]) | broken(m.springs.j[springs[k]]);
-        return found;
-      },
-      [](bool a, bool b) { return a || b; });
-  if (any_broken_end) {
-    for (const uint32_t e : springs) {
-      repaired += repair(m, snap, m.springs.i[e]) ? 1 : 0;
-      repaired += repair(m, snap, m.springs.j[e]) ? 1 : 0;
-    }
+  for (const uint32_t e : m.active_springs) {  // sleeping ends are read by the spring pass
+    if (m.active.empty()) break;
+    repaired += repair(m, snap, m.springs.i[e]) ? 1 : 0;
+    repaired += repair(m, snap, m.springs.j[e]) ? 1 : 0;
   }
   // Each chunk repairs and saves its own particles; only the count is merged.
   repaired += parallel_reduce_ordered(

@@ -88,10 +88,6 @@
 
 #include "systems/deform/membrane.hpp"
 
-namespace phaco {
-class PhasedTeam;  // engine/schedule/phased_team.hpp
-}  // namespace phaco
-
 namespace phaco::deform {
 
 enum class CgOperator : uint8_t { Assembled, MatrixFree };
@@ -226,8 +222,6 @@ struct StepSystem {
   Eigen::VectorXd rhs;        // 3 per unknown: b, mN·s
   Eigen::VectorXd guess, dv;  // 3 per unknown: CG's first guess and answer Δv, mm/s
   Eigen::VectorXd step_dx;    // 3 per unknown: Newton step Δx = dt·(v + Δv), mm
-  // Per chunk of the line search on the team: partial sums of Φ(0) and of Φ at the α on trial.
-  std::vector<double> potential_start, potential_trial;
 };
 
 // Work vectors of the row-chunked CG (implicit_team_cg.cpp), kept between steps: a steady-state
@@ -290,10 +284,6 @@ inline double mass_scale(const Dynamics& d) {
 double line_search(const Membrane& m, double dt, int max_halvings,
                    std::span<const uint32_t> unknowns, std::span<const uint32_t> unknown_of,
                    std::span<const uint32_t> springs, const double* step_dx);
-// line_search for implicit Euler, on the step's team: writes cache.system.step_dx = dt·(v + Δv)
-// from cache.system.dv, evaluates Φ in chunks of settings.parallel_grain_rows rows (and their share
-// of the springs) summed in chunk order, and returns α: the same bits on one thread and two.
-double line_search_on_team(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& team);
 // Adds the membrane's point loads on unknowns to a force vector laid out 3 per unknown (mN).
 void add_point_loads(const Membrane& m, std::span<const uint32_t> unknown_of, double* force);
 }  // namespace implicit_detail

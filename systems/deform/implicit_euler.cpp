@@ -290,8 +290,6 @@ void row_terms(const Membrane& m, double dt, ImplicitCache& cache, uint32_t ub, 
     for (int a = 0; a < 3; ++a) {
       sys.force[3 * u + a] = f[a];
       sys.rhs[3 * u + a] = dt * f[a] + dt2 * kv[a];
-      // Warm start: a particle's Δv changes little from frame to frame while a tool pulls steadily.
-      sys.guess[3 * u + a] = cache.settings.warm_start ? cache.warm_dv[3 * size_t(i) + a] : 0.0;
     }
   }
 }
@@ -308,7 +306,6 @@ void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& te
   list_point_loads(m, cache);
   sys.force.resize(3 * nu);
   sys.rhs.resize(3 * nu);
-  sys.guess.resize(3 * nu);
   sys.block.resize(cache.pattern.row_begin[nu]);
   const uint32_t chunks = implicit_detail::even_chunk_count(nu, cache.settings.parallel_grain_rows);
   const uint32_t rows_per = (nu + chunks - 1) / chunks, springs_per = (ns + chunks - 1) / chunks;
@@ -325,14 +322,70 @@ void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& te
     implicit_detail::write_matrix_values(cache.pattern, sys.block, sys.matrix);
 }
 
-// Moves unknowns [ub, ue) (x⁺ = x + α·Δx, v⁺ = α·Δx/dt) and keeps the Δv actually taken for the
-// next warm start; the force written is the one at the start of the step.
-void move_unknowns(Membrane& m, double dt, double alpha, ImplicitCache& cache, uint32_t ub,
-                   uint32_t ue) {
+}  // namespace
+
+void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
   Particles& p = m.particles;
-  const StepSystem& sys = cache.system;
-  for (uint32_t u = ub; u < ue; ++u) {
-    const uint32_t i = cache.unknowns.particles[u];
+  const uint32_t n = p.slots.size();
+  fit_particle_arrays(n, cache);
+  if (select_unknowns(m, cache)) build_pattern(m.springs, cache);
+  const UnknownSet& set = cache.unknowns;
+  StepSystem& sys = cache.system;
+  const size_t nu = set.particles.size();
+  ++cache.stats.steps;
+  cache.stats.unknowns = static_cast<uint32_t>(nu);
+  cache.stats.springs = static_cast<uint32_t>(set.springs.size());
+  cache.stats.nonzeros =
+      9 * uint64_t(cache.pattern.row_begin.empty() ? 0 : cache.pattern.row_begin.back());
+  if (nu == 0) {
+    cache.stats.cg_iterations = 0, cache.stats.cg_residual = 0.0, cache.stats.cg_converged = true;
+    return;
+  }
+  // A team for the assembly and the solve, formed now: its worker wakes while this thread selects
+  // and assembles (engine/schedule/phased_team.hpp). Let go before the solve if the solve is
+  // Eigen's, whose parallel loops need the worker free.
+  std::optional<PhasedTeam> team;
+  team.emplace(nu >= cache.settings.cg_team_min_rows);
+  assemble(m, dt, cache, *team);
+  const bool row_chunked = cache.settings.cg_operator == CgOperator::MatrixFree &&
+                           implicit_detail::team_cg_preconditioner(cache.settings.preconditioner);
+  if (!row_chunked) team.reset();
+  // Step 4. Diagonal preconditioners follow A every step; a factored one is rebuilt with the
+  // pattern only (a stale factor is still SPD: CG stays valid, only its speed depends on it).
+  implicit_detail::update_preconditioner(cache);
+
+  // Warm start: a particle's Δv changes little from frame to frame while a tool pulls steadily.
+  sys.guess.resize(3 * nu);
+  for (size_t u = 0; u < nu; ++u)
+    for (int a = 0; a < 3; ++a)
+      sys.guess[3 * u + a] =
+          cache.settings.warm_start ? cache.warm_dv[3 * set.particles[u] + a] : 0.0;
+  // Step 5. CG to the relative tolerance (implicit_solver.hpp: operator and preconditioners).
+  implicit_detail::solve_linear_system(cache, team ? &*team : nullptr);
+  team.reset();
+  cache.stats.cg_iterations_total += cache.stats.cg_iterations;
+
+  // Step 6. The linear solve is one Newton step of the incremental potential Φ (Gast et al. 2015);
+  // at k·dt²/m ≈ 10⁷ a full step can overshoot where springs rotate or buckle, so take the largest
+  // α in {1, ½, ...} that does not raise Φ.
+  sys.step_dx.resize(3 * nu);
+  for (size_t u = 0; u < nu; ++u) {
+    const uint32_t i = set.particles[u];
+    sys.step_dx[3 * u] = dt * (p.vx[i] + sys.dv[3 * u]);
+    sys.step_dx[3 * u + 1] = dt * (p.vy[i] + sys.dv[3 * u + 1]);
+    sys.step_dx[3 * u + 2] = dt * (p.vz[i] + sys.dv[3 * u + 2]);
+  }
+  const double alpha =
+      implicit_detail::line_search(m, dt, cache.settings.max_line_search_halvings, set.particles,
+                                   set.unknown_of, set.springs, sys.step_dx.data());
+  cache.stats.step_fraction = alpha;
+  if (alpha < 1.0) ++cache.stats.line_search_cuts;
+
+  // Move the unknowns (x⁺ = x + α·Δx, v⁺ = α·Δx/dt) and keep the Δv actually taken for the next
+  // warm start; the force written is the one at the start of the step.
+  if (m.forces.fx.size() != n) m.forces.resize_zero(n);
+  for (size_t u = 0; u < nu; ++u) {
+    const uint32_t i = set.particles[u];
     const double dx = alpha * sys.step_dx[3 * u], dy = alpha * sys.step_dx[3 * u + 1],
                  dz = alpha * sys.step_dx[3 * u + 2];
     for (int a = 0; a < 3; ++a) {
@@ -348,62 +401,6 @@ void move_unknowns(Membrane& m, double dt, double alpha, ImplicitCache& cache, u
     m.forces.fy[i] = static_cast<float>(sys.force[3 * u + 1]);
     m.forces.fz[i] = static_cast<float>(sys.force[3 * u + 2]);
   }
-}
-
-}  // namespace
-
-void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
-  Particles& p = m.particles;
-  const uint32_t n = p.slots.size();
-  fit_particle_arrays(n, cache);
-  if (select_unknowns(m, cache)) build_pattern(m.springs, cache);
-  const UnknownSet& set = cache.unknowns;
-  const size_t nu = set.particles.size();
-  ++cache.stats.steps;
-  cache.stats.unknowns = static_cast<uint32_t>(nu);
-  cache.stats.springs = static_cast<uint32_t>(set.springs.size());
-  cache.stats.nonzeros =
-      9 * uint64_t(cache.pattern.row_begin.empty() ? 0 : cache.pattern.row_begin.back());
-  if (nu == 0) {
-    cache.stats.cg_iterations = 0, cache.stats.cg_residual = 0.0, cache.stats.cg_converged = true;
-    return;
-  }
-  // A team for the assembly, the solve and the line search, formed now: its worker wakes while this
-  // thread selects and assembles (engine/schedule/phased_team.hpp). Let go before the solve if the
-  // solve is Eigen's, whose parallel loops need the worker free.
-  std::optional<PhasedTeam> team;
-  team.emplace(nu >= cache.settings.cg_team_min_rows);
-  assemble(m, dt, cache, *team);
-  const bool row_chunked = cache.settings.cg_operator == CgOperator::MatrixFree &&
-                           implicit_detail::team_cg_preconditioner(cache.settings.preconditioner);
-  if (!row_chunked) team.reset();
-  // Step 4. Diagonal preconditioners follow A every step; a factored one is rebuilt with the
-  // pattern only (a stale factor is still SPD: CG stays valid, only its speed depends on it).
-  implicit_detail::update_preconditioner(cache);
-
-  // Step 5. CG to the relative tolerance (implicit_solver.hpp: operator and preconditioners), from
-  // the warm start the assembly wrote (row_terms).
-  implicit_detail::solve_linear_system(cache, team ? &*team : nullptr);
-  cache.stats.cg_iterations_total += cache.stats.cg_iterations;
-  if (!team) team.emplace(nu >= cache.settings.cg_team_min_rows);  // Eigen's CG let it go
-
-  // Step 6. The linear solve is one Newton step of the incremental potential Φ (Gast et al. 2015);
-  // at k·dt²/m ≈ 10⁷ a full step can overshoot where springs rotate or buckle, so take the largest
-  // α in {1, ½, ...} that does not raise Φ. On the team, as the move after it: both are per row
-  // and per spring (implicit_line_search.cpp).
-  const double alpha = implicit_detail::line_search_on_team(m, dt, cache, *team);
-  cache.stats.step_fraction = alpha;
-  if (alpha < 1.0) ++cache.stats.line_search_cuts;
-  if (m.forces.fx.size() != n) m.forces.resize_zero(n);
-  const uint32_t chunks =
-      implicit_detail::even_chunk_count(uint32_t(nu), cache.settings.parallel_grain_rows);
-  const uint32_t rows_per = (uint32_t(nu) + chunks - 1) / chunks;
-  team->run(
-      chunks, 1, [](uint64_t) { return true; },
-      [&](uint64_t, uint32_t c) {
-        move_unknowns(m, dt, alpha, cache, std::min(uint32_t(nu), c * rows_per),
-                      std::min(uint32_t(nu), (c + 1) * rows_per));
-      });
 }
 
 }  // namespace phaco::deform

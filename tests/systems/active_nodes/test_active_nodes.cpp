@@ -1,13 +1,11 @@
 // Active node set: exact k-hop ball sizes on known grids, the springs it selects, the wake and
 // sleep rules, determinism and no allocation after warm-up.
 #include <gtest/gtest.h>
-#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
-#include "engine/core/rng.hpp"
 #include "procedures/eye/eye_mesh.hpp"
 #include "systems/active_nodes/active_nodes.hpp"
 #include "systems/springs/springs.hpp"
@@ -155,84 +153,6 @@ TEST(ActiveNodes, ForceOnTheSleepingFrontierWakesIt) {
   external.fz[g.at(8, 10)] = 0.04f;  // below the threshold
   active_nodes::update_active_set(g.graph, seed, 1, wake, set);
   EXPECT_FALSE(std::binary_search(set.particles.begin(), set.particles.end(), g.at(8, 10)));
-}
-
-// The wake rules as the header states them, particle by particle (no marks, no team): the ball,
-// every previous particle that moved or is loaded, the neighbours of those that moved, and every
-// sleeping neighbour of the previous set that is loaded.
-std::vector<uint32_t> wake_rules_reference(const Grid& g, const std::vector<uint32_t>& previous,
-                                           const std::vector<uint32_t>& ball, const WakeInputs& w) {
-  const double motion_sq = w.motion_threshold_mm * w.motion_threshold_mm;
-  const double load_sq = w.force_threshold_mn * w.force_threshold_mn;
-  auto loaded = [&](uint32_t p) {
-    double f[3] = {0.0, 0.0, 0.0};
-    for (uint32_t k = g.graph.begin(p); k < g.graph.end(p); ++k) {
-      const uint32_t q = g.graph.neighbour[k], e = g.graph.spring[k];
-      const double d[3] = {double(g.particles.x[q]) - g.particles.x[p],
-                           double(g.particles.y[q]) - g.particles.y[p],
-                           double(g.particles.z[q]) - g.particles.z[p]};
-      const double l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      for (int a = 0; a < 3; ++a)
-        f[a] += g.springs.stiffness[e] * (l - g.springs.rest_length[e]) * d[a] / l;
-    }
-    return f[0] * f[0] + f[1] * f[1] + f[2] * f[2] > load_sq;
-  };
-  auto moved = [&](uint32_t p) {
-    const Particles& x = *w.particles;
-    const double v2 =
-        double(x.vx[p]) * x.vx[p] + double(x.vy[p]) * x.vy[p] + double(x.vz[p]) * x.vz[p];
-    return v2 * w.dt_s * w.dt_s > motion_sq;
-  };
-  std::vector<uint32_t> out = ball;
-  for (uint32_t p : previous) {
-    if (moved(p) || loaded(p)) out.push_back(p);
-    for (uint32_t k = g.graph.begin(p); k < g.graph.end(p); ++k) {
-      const uint32_t q = g.graph.neighbour[k];
-      const bool was_active = std::binary_search(previous.begin(), previous.end(), q);
-      if (moved(p) || (!was_active && loaded(q))) out.push_back(q);
-    }
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-TEST(ActiveNodes, WakeRulesOnALargeSetAreTheRulesOnOneAndTwoThreads) {
-  // 900 previously active particles: the force tests split into chunks on the team.
-  Grid g = make_grid(61, true);
-  const uint32_t centre[] = {g.at(30, 30)};
-  ActiveSet warm;
-  active_nodes::update_active_set(g.graph, centre, 14, {}, warm);
-  ASSERT_EQ(warm.particles.size(), 29u * 29u);
-  // Scattered displacements (some load their particle and its neighbours) and velocities (some
-  // above the motion threshold), from a counter-based generator.
-  const CounterRng rng(3);
-  for (uint32_t i = 0; i < g.particles.slots.size(); ++i) {
-    if (rng.uniform(0, i) < 0.03f) g.particles.z[i] += 0.1f * rng.uniform(1, i);
-    if (rng.uniform(2, i) < 0.02f) g.particles.vx[i] = 0.5f * rng.uniform(3, i);
-  }
-  WakeInputs wake{.particles = &g.particles,
-                  .dt_s = 0.01,
-                  .motion_threshold_mm = 1e-3,
-                  .springs = &g.springs,
-                  .force_threshold_mn = 0.05};
-  const uint32_t seed[] = {g.at(30, 30)};
-  ActiveSet ball_only;
-  active_nodes::update_active_set(g.graph, seed, 2, {}, ball_only);
-  const std::vector<uint32_t> expected =
-      wake_rules_reference(g, warm.particles, ball_only.particles, wake);
-  ASSERT_GT(expected.size(), ball_only.particles.size() + 20) << "the wake rules must matter here";
-  for (int threads : {1, 2}) {
-    ActiveSet set = warm;
-    tbb::task_arena arena(threads);
-    arena.execute([&] { active_nodes::update_active_set(g.graph, seed, 2, wake, set); });
-    EXPECT_EQ(set.particles, expected) << threads << " threads";
-    EXPECT_EQ(set.woken, expected.size() - ball_only.particles.size()) << threads << " threads";
-    std::vector<uint32_t> asleep;
-    for (uint32_t p : warm.particles)
-      if (!std::binary_search(expected.begin(), expected.end(), p)) asleep.push_back(p);
-    EXPECT_EQ(set.fell_asleep, asleep) << threads << " threads";
-  }
 }
 
 TEST(ActiveNodes, DeterministicAndAllocationFreeAfterWarmUp) {
