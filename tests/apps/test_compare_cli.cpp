@@ -22,7 +22,7 @@ using phaco::test::write_text;
 using Result = phaco::test::ShellResult;
 using phaco::test::shell;
 
-const fs::path kFixture = fs::path(PHACO_SOURCE_DIR) / "tests/apps/data/report_fixture.json";
+const fs::path kCompareFixture = fs::path(PHACO_SOURCE_DIR) / "tests/apps/data/report_fixture.json";
 
 TEST(CompareCli, HelpNamesTheCommand) {
   const Result r = phaco("compare --help");
@@ -33,8 +33,8 @@ TEST(CompareCli, HelpNamesTheCommand) {
 
 TEST(CompareCli, ReportWithItselfDiffersByNothingAndWritesJson) {
   const fs::path dir = temp_dir("self");
-  const Result r = phaco("compare " + kFixture.string() + " " + kFixture.string() + " --json " +
-                         (dir / "c.json").string());
+  const Result r = phaco("compare " + kCompareFixture.string() + " " + kCompareFixture.string() +
+                         " --json " + (dir / "c.json").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("ratio 1.000"), std::string::npos) << r.output;
   const json c = json::parse(read_text(dir / "c.json"));
@@ -49,24 +49,24 @@ TEST(CompareCli, ReportWithItselfDiffersByNothingAndWritesJson) {
 
 TEST(CompareCli, MalformedOrMissingInputIsBadInputNamingFileAndField) {
   const fs::path dir = temp_dir("bad");
-  json j = json::parse(read_text(kFixture));
+  json j = json::parse(read_text(kCompareFixture));
   j["series"]["hands"]["right"]["speed_mm_s"][7] = "fast";
   write_text(dir / "bad.json", j.dump());
-  Result r = phaco("compare " + (dir / "bad.json").string() + " " + kFixture.string());
+  Result r = phaco("compare " + (dir / "bad.json").string() + " " + kCompareFixture.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("bad.json: series.hands.right.speed_mm_s[7]: expected a number"),
             std::string::npos)
       << r.output;
-  r = phaco("compare " + kFixture.string());
+  r = phaco("compare " + kCompareFixture.string());
   EXPECT_EQ(r.code, 2);
-  r = phaco("compare " + kFixture.string() + " " + (dir / "none.json").string());
+  r = phaco("compare " + kCompareFixture.string() + " " + (dir / "none.json").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("none.json: cannot open"), std::string::npos) << r.output;
-  j = json::parse(read_text(kFixture));
+  j = json::parse(read_text(kCompareFixture));
   j["drill"] = "phaco_sculpting";
   write_text(dir / "other.json", j.dump());
-  r = phaco("report " + kFixture.string() + " --html " + (dir / "o.html").string() + " --expert " +
-            (dir / "other.json").string());
+  r = phaco("report " + kCompareFixture.string() + " --html " + (dir / "o.html").string() +
+            " --expert " + (dir / "other.json").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("drill"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "o.html"));
@@ -75,11 +75,12 @@ TEST(CompareCli, MalformedOrMissingInputIsBadInputNamingFileAndField) {
 
 TEST(CompareCli, ReportWithExpertHasTheComparisonSection) {
   const fs::path dir = temp_dir("report");
-  Result r = phaco("report " + kFixture.string() + " --html " + (dir / "plain.html").string());
+  Result r =
+      phaco("report " + kCompareFixture.string() + " --html " + (dir / "plain.html").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(read_text(dir / "plain.html").find("id=\"compare\""), std::string::npos);
-  r = phaco("report " + kFixture.string() + " --html " + (dir / "with.html").string() +
-            " --expert " + kFixture.string());
+  r = phaco("report " + kCompareFixture.string() + " --html " + (dir / "with.html").string() +
+            " --expert " + kCompareFixture.string());
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string page = read_text(dir / "with.html");
   EXPECT_NE(page.find("<section id=\"compare\">"), std::string::npos);

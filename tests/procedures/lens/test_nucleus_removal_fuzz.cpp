@@ -31,7 +31,7 @@
 namespace phaco::lens {
 namespace {
 
-constexpr double kDt = 1.0 / 120.0;
+constexpr double kFuzzDt = 1.0 / 120.0;
 constexpr int kPaths = test::asan_scaled(1000, 5);
 static_assert(test::kUnderAsan || kPaths == 1000, "Release runs issue 19's 1,000 paths");
 constexpr int kStepsPerPath = 16;
@@ -95,7 +95,7 @@ TEST(NucleusRemovalFuzz, RandomChopAspirateAndUltrasoundPathsKeepTheLensSound) {
     double pedal = std::floor(draw(0, 4));
     for (int k = 0; k < kStepsPerPath; ++k, ++frame) {
       if (k % 8 == 7) pedal = std::floor(draw(0, 4));
-      probe += vp * kDt, chopper += vc * kDt;
+      probe += vp * kFuzzDt, chopper += vc * kFuzzDt;
       LensTools tools;
       tools.probe_tip = probe;
       tools.probe_velocity = vp;
@@ -103,7 +103,7 @@ TEST(NucleusRemovalFuzz, RandomChopAspirateAndUltrasoundPathsKeepTheLensSound) {
       tools.chopper_tip = chopper;
       if (pedal >= 3) tools.phaco = lens_tools::PhacoTip{probe, axis, draw(0.1, 1)};
       if (pedal >= 2) tools.aspirator = lens_tools::Aspirator{probe, 0};
-      const FragmentLensStats st = step_fragment_lens(l, tools, rng, frame, kDt);
+      const FragmentLensStats st = step_fragment_lens(l, tools, rng, frame, kFuzzDt);
       held += st.held;
       ASSERT_TRUE(std::isfinite(l.vacuum_mmhg)) << "path " << path << " step " << k;
       double alive = 0;

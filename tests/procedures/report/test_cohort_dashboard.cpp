@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using phaco::report::CohortAttempt;
 
-size_t count(const std::string& text, const std::string& what) {
+size_t count_in(const std::string& text, const std::string& what) {
   size_t n = 0;
   for (size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
   return n;
@@ -52,7 +52,7 @@ TEST(CohortDashboard, OneCurvePerTraineeAndDrillWithPassRatesAndWeakestMetrics) 
   const std::string page = phaco::report::cohort_dashboard(cohort(), o);
   EXPECT_EQ(page.rfind("<!DOCTYPE html>", 0), 0u);
   // Ana and Ben in capsulorhexis, <Eve> in incision (her unscored rhexis draws no line).
-  EXPECT_EQ(count(page, "class=\"curve\""), 3u) << page;
+  EXPECT_EQ(count_in(page, "class=\"curve\""), 3u) << page;
   EXPECT_NE(page.find("data-trainee=\"Ana\" data-drill=\"capsulorhexis\""), std::string::npos);
   EXPECT_NE(page.find("data-trainee=\"Zoe &lt;Eve&gt;\" data-drill=\"corneal_incision\""),
             std::string::npos);
@@ -93,7 +93,7 @@ TEST(CohortDashboard, HeadlessChromiumShowsACurvePerTrainee) {
   const auto dom = phaco::test::shell("timeout 120 " + chromium + flags + " --dump-dom file://" +
                                       page.string() + " 2>/dev/null");
   // The browser's own parse of the page: three curves, each with its points.
-  EXPECT_EQ(count(dom.output, "<polyline class=\"curve\""), 3u) << dom.output.substr(0, 2000);
+  EXPECT_EQ(count_in(dom.output, "<polyline class=\"curve\""), 3u) << dom.output.substr(0, 2000);
   phaco::test::shell("timeout 120 " + chromium + flags + " --screenshot=" + shot.string() +
                      " --window-size=1000,1600 file://" + page.string());
   const cv::Mat img = cv::imread(shot.string(), cv::IMREAD_COLOR);

@@ -16,7 +16,7 @@
 namespace phaco {
 namespace {
 
-Scenario demo() {
+Scenario fragments_demo() {
   Scenario s = load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) /
                              "data/scenarios/phaco_sculpting_demo.json");
   s.eye.level = 0;
@@ -25,12 +25,12 @@ Scenario demo() {
   return s;
 }
 
-std::unique_ptr<Scene> run_all(const Scenario& s, int threads) {
+std::unique_ptr<Scene> run_fragments(const Scenario& s, int threads) {
   return test::run_to_end(s, threads);
 }
 
 TEST(LensFragments, TheProbeEmulsifiesAndAspiratesAndTheLensStaysFinite) {
-  auto scene = run_all(demo(), 1);
+  auto scene = run_fragments(fragments_demo(), 1);
   const Entity lens = *scene->body(BodyPart::Lens);
   const LensFragments& lf = scene->world.at<LensFragments>(lens);
   EXPECT_GT(lf.lens.cells_removed, 100u);
@@ -50,15 +50,15 @@ TEST(LensFragments, TheProbeEmulsifiesAndAspiratesAndTheLensStaysFinite) {
 }
 
 TEST(LensFragments, SameOnOneAndTwoThreads) {
-  const Scenario s = demo();
-  EXPECT_EQ(state_hash(*run_all(s, 1)), state_hash(*run_all(s, 2)));
+  const Scenario s = fragments_demo();
+  EXPECT_EQ(state_hash(*run_fragments(s, 1)), state_hash(*run_fragments(s, 2)));
 }
 
 TEST(LensFragments, SculptingMethodsDoNotApplyToFragments) {
-  Scenario s = demo();
+  Scenario s = fragments_demo();
   s.methods["lens.broadphase"] = "dbvt";
   EXPECT_THROW(build_scene(s, SceneOptions{}), InputError);
-  s = demo();
+  s = fragments_demo();
   s.methods["lens.model"] = "voxels";
   EXPECT_THROW(build_scene(s, SceneOptions{}), InputError);
 }

@@ -30,12 +30,12 @@ Scenario demo(int level) {
   return s;
 }
 
-std::unique_ptr<Scene> run_all(const Scenario& s, int threads) {
+std::unique_ptr<Scene> run_sculpting(const Scenario& s, int threads) {
   return test::run_to_end(s, threads);
 }
 
 TEST(LensSculpting, TheDivideAndConquerDemoCutsTwoCrossedTrenchesWithoutNaN) {
-  auto scene = run_all(demo(1), 1);
+  auto scene = run_sculpting(demo(1), 1);
   const Entity lens = *scene->body(BodyPart::Lens);
   const LensSculpting& ls = scene->world.at<LensSculpting>(lens);
   const Particles& p = scene->world.at<Particles>(lens);
@@ -110,7 +110,7 @@ Scenario expert_push(int level) {
 TEST(LensSculpting, TheSamePushTurnsTheNucleusAlikeAtEveryLevel) {
   std::vector<double> turn_deg;
   for (int level = 0; level <= 3; ++level) {
-    auto scene = run_all(expert_push(level), 2);
+    auto scene = run_sculpting(expert_push(level), 2);
     const LensSculpting& ls = scene->world.at<LensSculpting>(*scene->body(BodyPart::Lens));
     turn_deg.push_back(ls.rotation.angle_rad * 180.0 / std::numbers::pi);
     EXPECT_GT(ls.push_frames, 50u) << "level " << level;
@@ -127,10 +127,10 @@ TEST(LensSculpting, TheSamePushTurnsTheNucleusAlikeAtEveryLevel) {
 TEST(LensSculpting, SameResultOnOneAndTwoThreadsAndWithEitherBroadphase) {
   Scenario s = demo(0);
   s.duration_s = 26.0;  // the first trench and the turn
-  const std::string one = state_hash(*run_all(s, 1));
-  EXPECT_EQ(one, state_hash(*run_all(s, 2)));
+  const std::string one = state_hash(*run_sculpting(s, 1));
+  EXPECT_EQ(one, state_hash(*run_sculpting(s, 2)));
   s.methods["lens.broadphase"] = "dbvt";
-  EXPECT_EQ(one, state_hash(*run_all(s, 1))) << "the octree and btDbvt find the same tets";
+  EXPECT_EQ(one, state_hash(*run_sculpting(s, 1))) << "the octree and btDbvt find the same tets";
 }
 
 TEST(LensSculpting, NoUltrasoundNoRemoval) {
@@ -138,7 +138,7 @@ TEST(LensSculpting, NoUltrasoundNoRemoval) {
   for (auto& hand : s.hands)
     for (auto& sample : hand.track) sample.pedal = std::min(sample.pedal, 2.0);
   s.duration_s = 10.0;
-  auto scene = run_all(s, 1);
+  auto scene = run_sculpting(s, 1);
   const LensSculpting& ls = scene->world.at<LensSculpting>(*scene->body(BodyPart::Lens));
   EXPECT_EQ(ls.topology.alive_count, ls.topology.tet_count);
   EXPECT_EQ(ls.strokes, 0u);
@@ -148,7 +148,7 @@ TEST(LensSculpting, UnknownMethodsAndBodiesAreNamed) {
   Scenario s = demo(0);
   s.methods["lens.broadphase"] = "kd_tree";
   try {
-    run_all(s, 1);
+    run_sculpting(s, 1);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("lens.broadphase"), std::string::npos) << e.what();
@@ -157,7 +157,8 @@ TEST(LensSculpting, UnknownMethodsAndBodiesAreNamed) {
   Scenario rhexis = load_scenario(std::filesystem::path(PHACO_SOURCE_DIR) /
                                   "data/scenarios/capsulorhexis_demo.json");
   rhexis.methods["lens.narrowphase"] = "exact_gjk";
-  EXPECT_THROW(run_all(rhexis, 1), InputError) << "the capsulorhexis scene has no tetrahedral lens";
+  EXPECT_THROW(run_sculpting(rhexis, 1), InputError)
+      << "the capsulorhexis scene has no tetrahedral lens";
 }
 
 }  // namespace

@@ -226,7 +226,7 @@ INSTANTIATE_TEST_SUITE_P(
                                                                                 : "_edge");
     });
 
-Vec3 P(double x, double y) {
+Vec3 grasp_at(double x, double y) {
   return {x, y, 0.0};
 }
 
@@ -236,7 +236,7 @@ TEST(GraspPoint, OnARimEdgeSplitsItsOneTriangle) {
   CutMesh m = s.mesh();
   EditLog log;
   const CutSettings settings = settings_for(1.0);
-  GraspPoint g = grasp_near(m, P(1.5, 0.0), 0, settings, log);
+  GraspPoint g = grasp_near(m, grasp_at(1.5, 0.0), 0, settings, log);
   ASSERT_TRUE(g.held());
   EXPECT_EQ(g.kind, CutPoint::Edge);
   EXPECT_EQ(g.insertion.original_count, 1u);
@@ -256,12 +256,12 @@ TEST(GraspPoint, ACutThroughTheTemporaryVertexKeepsIt) {
   CutMesh m = s.mesh();
   EditLog log;
   const CutSettings settings = settings_for(1.0);
-  GraspPoint g = grasp_near(m, P(2.3, 2.6), 0, settings, log);
+  GraspPoint g = grasp_near(m, grasp_at(2.3, 2.6), 0, settings, log);
   ASSERT_TRUE(g.held());
   ASSERT_EQ(g.kind, CutPoint::Face);
   const uint32_t q = g.particle;
   CutPath path;
-  for (const Vec3& x : {P(0.6, 2.6), P(2.3, 2.6), P(4.4, 2.6)})
+  for (const Vec3& x : {grasp_at(0.6, 2.6), grasp_at(2.3, 2.6), grasp_at(4.4, 2.6)})
     cut_towards(m, path, x, settings, log);
   ASSERT_GE(path.segments, 1u);
   EXPECT_EQ(insertion_state(m, g.insertion), InsertionState::Changed);
@@ -280,10 +280,10 @@ TEST(GraspPoint, ACutElsewhereDoesNotStopTheRelease) {
   CutMesh m = s.mesh();
   EditLog log;
   const CutSettings settings = settings_for(1.0);
-  GraspPoint g = grasp_near(m, P(2.3, 2.6), 0, settings, log);
+  GraspPoint g = grasp_near(m, grasp_at(2.3, 2.6), 0, settings, log);
   ASSERT_TRUE(g.temporary);
   CutPath path;
-  for (const Vec3& x : {P(0.6, 4.5), P(2.3, 4.5), P(4.4, 4.5)})
+  for (const Vec3& x : {grasp_at(0.6, 4.5), grasp_at(2.3, 4.5), grasp_at(4.4, 4.5)})
     cut_towards(m, path, x, settings, log);
   ASSERT_GE(path.segments, 1u);
   EXPECT_EQ(insertion_state(m, g.insertion), InsertionState::Intact);
@@ -332,7 +332,7 @@ TEST(GraspPoint, ReleaseHandsOnTheVertexMomentum) {
   CutSheet s = prepared(phaco::test::grid_mesh(6, 0.15));
   CutMesh m = s.mesh();
   EditLog log;
-  GraspPoint g = grasp_near(m, P(2.35, 2.62), 0, settings_for(1.0), log);
+  GraspPoint g = grasp_near(m, grasp_at(2.35, 2.62), 0, settings_for(1.0), log);
   ASSERT_TRUE(g.temporary);
   Particles& p = s.particles;
   for (uint32_t v = 0; v < p.slots.size(); ++v) {
@@ -369,14 +369,14 @@ TEST(GraspPoint, QualitySnapMovesASliverSplitToTheEdge) {
   // 0.02 from the edge y = 1 (beyond the 0.01 edge snap): a face split would leave a 2.3° angle.
   CutSettings settings = settings_for(1.0);
   settings.snap.edge_snap_mm = 0.01;
-  GraspPoint g = grasp_near(m, P(1.5, 1.02), 0, settings, log);
+  GraspPoint g = grasp_near(m, grasp_at(1.5, 1.02), 0, settings, log);
   ASSERT_TRUE(g.held());
   EXPECT_EQ(g.kind, CutPoint::Edge);
   EXPECT_NEAR(g.moved_mm, 0.02, 1e-6);
   EXPECT_TRUE(sound(s));
   settings.min_angle_deg = 1.0;  // the split is allowed
   release(m, g, log);
-  g = grasp_near(m, P(1.5, 1.02), 0, settings, log);
+  g = grasp_near(m, grasp_at(1.5, 1.02), 0, settings, log);
   EXPECT_EQ(g.kind, CutPoint::Face);
   EXPECT_TRUE(sound(s));
 }
@@ -388,10 +388,11 @@ TEST(GraspPoint, AnchoredTissueIsNotGrasped) {
   CutMesh m = s.mesh();
   EditLog log;
   const uint32_t np = s.particles.slots.live_count();
-  EXPECT_FALSE(grasp_near(m, P(1.0, 1.0), 0, settings_for(1.0), log).held());  // vertex 6
-  EXPECT_FALSE(grasp_near(m, P(1.5, 0.0), 0, settings_for(1.0), log).held());  // rim edge 1-2
+  EXPECT_FALSE(grasp_near(m, grasp_at(1.0, 1.0), 0, settings_for(1.0), log).held());  // vertex 6
+  EXPECT_FALSE(
+      grasp_near(m, grasp_at(1.5, 0.0), 0, settings_for(1.0), log).held());  // rim edge 1-2
   EXPECT_EQ(s.particles.slots.live_count(), np);
-  EXPECT_TRUE(grasp_near(m, P(1.5, 1.5), 0, settings_for(1.0), log)
+  EXPECT_TRUE(grasp_near(m, grasp_at(1.5, 1.5), 0, settings_for(1.0), log)
                   .held());  // a triangle with a free corner
 }
 

@@ -18,13 +18,14 @@
 namespace phaco::haptic_model {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPortPi = 3.14159265358979323846;
 constexpr double kTunnel = 200.0, kHalfWidth = 1.2, kLength = 1.75;
 
 // The main port of the standard eye, roughly: at 3 o'clock in the stroma, its tunnel running in
 // and 15° down, 2.4 mm wide along the limbus.
 const Vec3 kCentre(5.5, 0.0, 3.0);
-const Vec3 kAxis = Vec3(-std::cos(15 * kPi / 180), 0.0, -std::sin(15 * kPi / 180)).normalized();
+const Vec3 kAxis =
+    Vec3(-std::cos(15 * kPortPi / 180), 0.0, -std::sin(15 * kPortPi / 180)).normalized();
 const Vec3 kAcross = Vec3::UnitY();
 const Vec3 kThrough = kAxis.cross(kAcross);
 
@@ -71,7 +72,7 @@ TEST(PortPlanes, AShaftThroughThePortsCentreFeelsNothing) {
     // The same tip with the shaft levered 5° about it is felt.
     // About the slit's long direction, so the shaft's line leaves the centre through the slit.
     const Vec3 about = (kAcross - kAcross.dot(shaft) * shaft).normalized();
-    const Vec3 levered = Eigen::AngleAxisd(5 * kPi / 180, about) * shaft;
+    const Vec3 levered = Eigen::AngleAxisd(5 * kPortPi / 180, about) * shaft;
     EXPECT_GT(held_at(*port, tip, levered).force_mn.norm(), 5.0) << tip.transpose();
   }
 }
@@ -122,7 +123,7 @@ TEST(PortPlanes, TheTunnelPushesPerpendicularToTheShaft) {
   const Vec3 through = (kCentre - tip).normalized();
   for (double deg : {3.0, 8.0, 15.0}) {
     for (const Vec3& about : {kAcross, Vec3(0.3, 1, 0.2).normalized()}) {
-      const Vec3 shaft = Eigen::AngleAxisd(deg * kPi / 180, about) * through;
+      const Vec3 shaft = Eigen::AngleAxisd(deg * kPortPi / 180, about) * through;
       const HapticForce f = held_at(*port, tip, shaft);
       ASSERT_GT(f.force_mn.norm(), 1.0) << deg;
       EXPECT_LT(std::abs(f.force_mn.normalized().dot(shaft)), 1e-6) << deg;
@@ -212,17 +213,19 @@ double port_jump(double blend_ms, double blend_max_step, double* range_out) {
     const double t = k * s.dt_s;
     const bool stalled = t > 0.6 && t < 0.8;
     if (t >= next_model && !stalled) {
-      const Vec3 turn = 0.3 * Vec3(0, std::sin(2 * kPi * 2.1 * t), std::cos(2 * kPi * 1.8 * t));
+      const Vec3 turn =
+          0.3 * Vec3(0, std::sin(2 * kPortPi * 2.1 * t), std::cos(2 * kPortPi * 1.8 * t));
       model = port_tool(kCentre + turn);
       adopt_model(*model, *st, s);
       next_model += 1.0 / 30.0;
       while (next_model <= t) next_model += 1.0 / 30.0;
     }
     // The tip wanders in the chamber; the shaft aims at a point circling the rest centre.
-    const Vec3 tip = kCentre + 3.0 * kAxis +
-                     0.8 * Vec3(std::cos(2 * kPi * 0.5 * t), std::sin(2 * kPi * 0.6 * t), 0);
-    const Vec3 aim = kCentre + 0.4 * std::sin(2 * kPi * 0.9 * t) * kThrough +
-                     1.5 * std::cos(2 * kPi * 0.7 * t) * kAcross;
+    const Vec3 tip =
+        kCentre + 3.0 * kAxis +
+        0.8 * Vec3(std::cos(2 * kPortPi * 0.5 * t), std::sin(2 * kPortPi * 0.6 * t), 0);
+    const Vec3 aim = kCentre + 0.4 * std::sin(2 * kPortPi * 0.9 * t) * kThrough +
+                     1.5 * std::cos(2 * kPortPi * 0.7 * t) * kAcross;
     const HapticForce f =
         haptic_tick(st->newest_model(), tip, Vec3::Zero(), (aim - tip).normalized(), s, *st);
     EXPECT_TRUE(std::isfinite(f.force_mn.norm()));

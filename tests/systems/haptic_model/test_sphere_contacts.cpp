@@ -57,7 +57,8 @@ std::unique_ptr<HapticTool> slab(const Vec3& near, double half, double depth,
   return t;
 }
 
-std::unique_ptr<HapticToolState> fresh(const HapticTool& model, const HapticSettings& s) {
+std::unique_ptr<HapticToolState> fresh_contact_state(const HapticTool& model,
+                                                     const HapticSettings& s) {
   auto st = std::make_unique<HapticToolState>();
   adopt_model(model, *st, s);
   return st;
@@ -76,7 +77,7 @@ TEST(SphereContacts, OneSphereIsASpringInSeriesWithTheCoupling) {
   const Vec3 c(0.3, -0.2, 0.1);
   auto t = tool_at(c + Vec3(0, 0, 2));
   add_sphere(*t, c, 0.2, 150);
-  auto st = fresh(*t, s);
+  auto st = fresh_contact_state(*t, s);
   const double kser = s.coupling_stiffness_mn_per_mm * 150 / (s.coupling_stiffness_mn_per_mm + 150);
   const Vec3 dir = Vec3(0.3, 0.4, 1).normalized();
   // Approach along dir (the proxy comes from outside, as a hand does), then hold at each depth.
@@ -100,7 +101,7 @@ TEST(SphereContacts, ASlabOfSpheresIsFeltAsOneSurfaceAlongItsNormal) {
   double last = 0;
   for (const Vec3 xy : {Vec3(0, 0, 0), Vec3(0.1, 0, 0), Vec3(0.1, 0.1, 0), Vec3(0.037, 0.071, 0)}) {
     auto t = slab(xy, 1.6, 0.6);
-    auto st = fresh(*t, s);
+    auto st = fresh_contact_state(*t, s);
     hold(*t, xy + Vec3(0, 0, 1.0), s, *st);
     double prev = 0;
     for (double z = 0.62; z >= 0.3; z -= 0.02) {
@@ -129,7 +130,7 @@ TEST(SphereContacts, TheProxyStaysOutWhenTheDeviceGoesThroughTheMaterial) {
   HapticSettings s;
   s.coupling_stiffness_mn_per_mm = 200;
   auto t = slab(Vec3::Zero(), 1.6, 0.6);
-  auto st = fresh(*t, s);
+  auto st = fresh_contact_state(*t, s);
   hold(*t, Vec3(0.05, 0.02, 1.0), s, *st);
   // A jump 1.2 mm down in one tick, below the top cells' centres: the material (k = 100, soft
   // next to k_c) lets the proxy in, but keeps pushing it out, up, with the stiffness of the
@@ -151,7 +152,7 @@ TEST(SphereContacts, TheProxyStaysOutWhenTheDeviceGoesThroughTheMaterial) {
 TEST(SphereContacts, UnderUltrasoundTheMaterialYieldsAtTheCutForce) {
   HapticSettings s;
   auto t = slab(Vec3::Zero(), 1.6, 0.6);
-  auto stiff = fresh(*t, s);
+  auto stiff = fresh_contact_state(*t, s);
   hold(*t, Vec3(0, 0, 1.0), s, *stiff);
   const HapticForce pressed = hold(*t, Vec3(0, 0, 0.2), s, *stiff, 10);
   const double kser = s.coupling_stiffness_mn_per_mm * 100 / (s.coupling_stiffness_mn_per_mm + 100);
@@ -159,7 +160,7 @@ TEST(SphereContacts, UnderUltrasoundTheMaterialYieldsAtTheCutForce) {
   EXPECT_EQ(pressed.active & kTermCut, 0);
 
   t->cut_force_mn = 12.0f;
-  auto cut = fresh(*t, s);
+  auto cut = fresh_contact_state(*t, s);
   hold(*t, Vec3(0, 0, 1.0), s, *cut);
   for (double z : {0.55, 0.4, 0.2, 0.0}) {
     const HapticForce f = hold(*t, Vec3(0, 0, z), s, *cut, 10);
