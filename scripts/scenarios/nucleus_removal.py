@@ -78,8 +78,8 @@ def crack(mid, d, offsets, sep=(1.0, 1.8), z=None):
     midpoint, then 0.2 mm more spread); bringing the tips together re-arms it for the next place.
     The spread runs past the trench's width (1.35 mm in the drill, 1.5 in the procedure's carried
     trench) into its walls, as a surgeon's does: to 1.8 mm (it was 1.6, 1.4 for the first crack),
-    more slowly (0.45 s); to 2.0 mm chipped the quadrants into more pieces and left less to
-    remove (0.40 of the lens instead of 0.73 in one run; docs/nucleus_removal.md)."""
+    more slowly (0.45 s); to 2.0 mm the drill removed less after the cracks (0.40 of the lens
+    instead of 0.73, one run each; docs/nucleus_removal.md)."""
     def at(c, h): return [mid[0] + (c + h) * d[0], mid[1] + (c + h) * d[1]]
     zc = Z_CRACK if z is None else z
     o = offsets[0]
