@@ -93,7 +93,7 @@ std::vector<LensToolsRow> measure_lens_tools(std::span<const uint32_t> cell_coun
             tip.power = 0.6;
             const Aspirator asp{tip.apex, 300.0};  // the phaco tip aspirates through its port
             Hook hook;
-            hook.a = Vec3(-1.5 + 0.8 * time, 0.5, 1.2);
+            hook.a = hook.bend = Vec3(-1.5 + 0.8 * time, 0.5, 1.2);
             hook.b = hook.a + Vec3(0, 0, 1.0);
             hook.velocity = Vec3(0.8, 0, 0);
             const CellSpans cells = cell_spans(c);

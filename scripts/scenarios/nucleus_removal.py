@@ -9,9 +9,8 @@ guidance.trench_cross: one trench along x, one along y, 1.35 mm wide, 80 % deep)
   1. both tips into the x trench at x = -1.2, on its walls, pushed apart across it: the nucleus
      cracks into two halves along y = 0;
   2. the same in the y trench of the -y half (at y = -1.2, then -0.8), then of the +y half
-     (y = +1.2, then +0.8; higher), pushed apart at ten places across the trench at each, since
-     the halves move once apart (crack()):
-     four quadrants;
+     (y = +1.2, then +0.8, higher, then +1.0 deep in the trench), pushed apart at ten places
+     across the trench at each, since the halves move once apart (crack()): four quadrants;
   3. for each quadrant: the probe into its inner corner with aspiration (pedal 2) until the port
      occludes and the vacuum holds the quadrant, then ultrasound (pedal 3) while the vacuum feeds it
      into the tip; lift.
@@ -68,7 +67,7 @@ park_p = inward(main, 3.0, Z_ABOVE)
 park_c = inward(side, 3.0, Z_ABOVE)
 both(1.0, park_p, 1, park_c)
 
-def crack(mid, d, offsets, sep=(1.0, 1.6), z=None):
+def crack(mid, d, offsets, sep=(1.0, 1.8), z=None):
     """The probe and the chopper down in a trench about `mid` (x, y), on either side along `d`
     (the unit push, chopper -> probe), then, at each of `offsets` (mm along `d` from `mid`, in
     turn), pushed apart from sep[0] to sep[1] and brought back together as they move on; lifted.
@@ -76,7 +75,11 @@ def crack(mid, d, offsets, sep=(1.0, 1.6), z=None):
     mm at 1.2 mm from the centre, the carried trench of a procedure more than the drill's groove,
     and the pieces settle differently run to run), and blind tips cannot see where it went. The
     push cracks where it engages (lens_tools/crack: both tips on the fragment, no cell at their
-    midpoint, then 0.2 mm more spread); bringing the tips together re-arms it for the next place."""
+    midpoint, then 0.2 mm more spread); bringing the tips together re-arms it for the next place.
+    The spread runs past the trench's width (1.35 mm in the drill, 1.5 in the procedure's carried
+    trench) into its walls, as a surgeon's does: to 1.8 mm (it was 1.6, 1.4 for the first crack),
+    more slowly (0.45 s); to 2.0 mm the drill removed less after the cracks (0.40 of the lens
+    instead of 0.73, one run each; docs/nucleus_removal.md)."""
     def at(c, h): return [mid[0] + (c + h) * d[0], mid[1] + (c + h) * d[1]]
     zc = Z_CRACK if z is None else z
     o = offsets[0]
@@ -84,13 +87,13 @@ def crack(mid, d, offsets, sep=(1.0, 1.6), z=None):
     both(0.6, at(o, 0.5 * sep[0]) + [zc], 1, at(o, -0.5 * sep[0]) + [zc])
     for k, o in enumerate(offsets):
         if k:
-            both(0.15, at(o, 0.5 * sep[0]) + [zc], 1, at(o, -0.5 * sep[0]) + [zc])
-        both(0.3, at(o, 0.5 * sep[1]) + [zc], 1, at(o, -0.5 * sep[1]) + [zc])
+            both(0.2, at(o, 0.5 * sep[0]) + [zc], 1, at(o, -0.5 * sep[0]) + [zc])
+        both(0.45, at(o, 0.5 * sep[1]) + [zc], 1, at(o, -0.5 * sep[1]) + [zc])
     both(0.6, at(o, 0.5 * sep[1]) + [Z_ABOVE], 1, at(o, -0.5 * sep[1]) + [Z_ABOVE])
 
 Y_ROWS = (1.2, 0.8)
 ACROSS = [-0.8, -0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0]
-crack([-1.2, 0.0], [0.0, -1.0], [0.0], sep=(0.8, 1.4))  # along the x trench: two halves
+crack([-1.2, 0.0], [0.0, -1.0], [0.0], sep=(0.8, 1.8))  # along the x trench: two halves
 # Each y crack is tried 1.2 mm from the centre, then 0.8 mm: once the halves part they sink and
 # tip toward the x crack, by how much depends on the lens's resolution (their centroids sit at
 # |y| = 0.57 mm at level 3, 1.2 mm at level 1), and at the tips' height the slice out at 1.2 mm
@@ -98,8 +101,14 @@ crack([-1.2, 0.0], [0.0, -1.0], [0.0], sep=(0.8, 1.4))  # along the x trench: tw
 # half). A blind hand tries both; once a half has cracked, the second row straddles the crack.
 for y in Y_ROWS:
     crack([0.0, -y], [1.0, 0.0], ACROSS)   # the -y half along the y trench
-for y in Y_ROWS:
-    crack([0.0, y], [1.0, 0.0], ACROSS, z=0.1)  # the +y half, higher: its pieces sank
+# The +y half at 1.2 and 0.8 mm 0.4 mm above the -y rows, then deep in its trench at 1.0 mm as
+# a last try. Where it lies after the first two cracks varies from run to run (it sinks and tips
+# toward the x crack while the -y half is cracked): under a cohort's tremor, tempo and offsets the
+# two high rows alone cracked it in 1 of 3 hands tried (docs/nucleus_removal.md); the deep row
+# at 1.0 mm cracked one of those that missed, and with it every hand tried cracked it.
+Y_PLUS_ROWS = ((1.2, 0.1), (0.8, 0.1), (1.0, -0.5))
+for y, z in Y_PLUS_ROWS:
+    crack([0.0, y], [1.0, 0.0], ACROSS, z=z)  # the +y half
 
 chopper_park = [-1.0, 0.0, Z_ABOVE]
 occlude_pedal = 3 if args.wasteful else 2

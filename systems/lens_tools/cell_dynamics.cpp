@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "engine/core/invariants.hpp"
+#include "engine/io/tool_shape.hpp"
 #include "engine/schedule/parallel.hpp"
 
 namespace phaco::lens_tools {
@@ -44,9 +45,11 @@ void aspirate(const CellSpans& cells, const Aspirator& a, const AspiratorSetting
 
 Hook hook_from_poses(const ToolPose& pose, const ToolPose& prev, double dt_s,
                      const HookSettings& s) {
+  const ShaftAxis axis = shaft_axis(pose, ToolKind::Hook);
   Hook h;
   h.a = pose.pos;
-  h.b = pose.pos + s.shaft_length_mm * (pose.quat.normalized() * Vec3::UnitZ());
+  h.bend = axis.point;
+  h.b = axis.point + s.shaft_length_mm * axis.direction;
   h.velocity = dt_s > 0 ? Vec3((pose.pos - prev.pos) / dt_s) : Vec3(Vec3::Zero());
   return h;
 }
@@ -63,15 +66,18 @@ void drag_with_hook(const CellSpans& cells, const Hook& h, const HookSettings& s
   if (!(s.radius_mm > 0) || !(dt_s > 0) || !(s.drag_rate_per_s > 0)) return;
   const float beta = static_cast<float>(1.0 - std::exp(-s.drag_rate_per_s * dt_s));
   const float r2 = static_cast<float>(s.radius_mm * s.radius_mm);
-  const float ax = static_cast<float>(h.a.x()), ay = static_cast<float>(h.a.y()),
-              az = static_cast<float>(h.a.z());
-  const float bx = static_cast<float>(h.b.x() - h.a.x()),
-              by = static_cast<float>(h.b.y() - h.a.y()),
-              bz = static_cast<float>(h.b.z() - h.a.z());
+  // Two segments, each from its start (o) along its run (u): the bent end, then the shaft.
+  struct SegmentF {
+    float ox, oy, oz, ux, uy, uz, inv_len2;
+  };
+  const auto segment = [](const Vec3& from, const Vec3& to) {
+    const Vec3f o = from.cast<float>(), u = (to - from).cast<float>();
+    const float len2 = u.squaredNorm();
+    return SegmentF{o.x(), o.y(), o.z(), u.x(), u.y(), u.z(), len2 > 0 ? 1.0f / len2 : 0.0f};
+  };
+  const SegmentF end = segment(h.a, h.bend), shaft = segment(h.bend, h.b);
   const float hx = static_cast<float>(h.velocity.x()), hy = static_cast<float>(h.velocity.y()),
               hz = static_cast<float>(h.velocity.z());
-  const float len2 = bx * bx + by * by + bz * bz;
-  const float inv_len2 = len2 > 0 ? 1.0f / len2 : 0.0f;
 
   const float* __restrict x = cells.x.data();
   const float* __restrict y = cells.y.data();
@@ -81,13 +87,18 @@ void drag_with_hook(const CellSpans& cells, const Hook& h, const HookSettings& s
   float* __restrict vz = cells.vz.data();
   const uint8_t* __restrict alive = cells.alive.data();
   parallel_for(0, cells.size(), kCellGrain, [=](uint32_t b, uint32_t e, int) {
+    const auto dist2 = [](const SegmentF& g, float cx, float cy, float cz) {
+      const float px = cx - g.ox, py = cy - g.oy, pz = cz - g.oz;
+      const float t =
+          std::min(std::max((px * g.ux + py * g.uy + pz * g.uz) * g.inv_len2, 0.0f), 1.0f);
+      const float dx = px - t * g.ux, dy = py - t * g.uy, dz = pz - t * g.uz;
+      return dx * dx + dy * dy + dz * dz;
+    };
     // Branch-free (no unpredictable jump per cell): cells outside the cylinder, or dead, blend by
     // 0.
     for (uint32_t i = b; i < e; ++i) {
-      const float px = x[i] - ax, py = y[i] - ay, pz = z[i] - az;
-      const float t = std::min(std::max((px * bx + py * by + pz * bz) * inv_len2, 0.0f), 1.0f);
-      const float dx = px - t * bx, dy = py - t * by, dz = pz - t * bz;
-      const bool inside = (alive[i] != 0) & (dx * dx + dy * dy + dz * dz <= r2);
+      const float d2 = std::min(dist2(end, x[i], y[i], z[i]), dist2(shaft, x[i], y[i], z[i]));
+      const bool inside = (alive[i] != 0) & (d2 <= r2);
       const float w = inside ? beta : 0.0f;
       vx[i] += w * (hx - vx[i]);
       vy[i] += w * (hy - vy[i]);

@@ -39,27 +39,34 @@ void aspirate(const CellSpans& cells, const Aspirator& a, const AspiratorSetting
 
 // ---- hook ---------------------------------------------------------------------------------------
 
+// The hook's cylinder surrounds the instrument as drawn: its bent end from the point `a` to the
+// bend, then the shaft from the bend to `b` (a straight hook: bend = a).
 struct Hook {
-  Vec3 a = Vec3::Zero(), b = Vec3::UnitZ();  // mm, the shaft segment the cylinder surrounds
-  Vec3 velocity = Vec3::Zero();              // mm/s, the hook's velocity this frame
+  Vec3 a = Vec3::Zero();         // mm, the point
+  Vec3 bend = Vec3::Zero();      // mm, where the bent end meets the shaft
+  Vec3 b = Vec3::UnitZ();        // mm, the shaft's end in the lens's reach
+  Vec3 velocity = Vec3::Zero();  // mm/s, the hook's velocity this frame
 };
 
 struct HookSettings {
   double radius_mm = 0.3;          // cylinder radius around segment ab (capped ends)
   double drag_rate_per_s = 200.0;  // velocity blend rate r: β = 1 − exp(−r·dt)
-  double shaft_length_mm = 1.0;    // used by hook_from_poses
+  double shaft_length_mm = 1.0;    // the shaft above the bend, used by hook_from_poses
 };
 
-// The hook from this frame's and last frame's poses: segment from the tip along the shaft
-// (quat · +z) for shaft_length_mm, velocity (pos − prev.pos)/dt.
+// The hook from this frame's and last frame's poses, as the instrument is drawn
+// (engine/io/tool_shape.hpp): the 1 mm bent end from the tip to the shaft's axis, then the shaft
+// along quat · +z for shaft_length_mm; velocity (pos − prev.pos)/dt. (It was the segment from the
+// tip along +z: a line 1 mm beside the real shaft, through cells no part of the hook touches.)
 Hook hook_from_poses(const ToolPose& pose, const ToolPose& prev, double dt_s,
                      const HookSettings& s);
 
 // Distance from p to segment ab (a point when a = b).
 double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b);
 
-// Drag: a cell within radius of the segment takes v ← v + β (v_hook − v), β = 1 − exp(−r·dt) (so
-// the blend does not depend on how the frame is split: two half steps equal one full one).
+// Drag: a cell within radius of the bent end [a, bend] or the shaft [bend, b] takes v ← v + β
+// (v_hook − v), β = 1 − exp(−r·dt) (so the blend does not depend on how the frame is split: two
+// half steps equal one full one).
 void drag_with_hook(const CellSpans& cells, const Hook& h, const HookSettings& s, double dt_s);
 
 // ---- gravity and viscosity ----------------------------------------------------------------------

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "engine/io/tool_shape.hpp"
 #include "systems/lens_tools/cell_dynamics.hpp"
 #include "tests/systems/lens_tools/cell_fixture.hpp"
 
@@ -60,7 +61,7 @@ TEST(Aspirator, NoVacuumNoPull) {
 TEST(Hook, DragsCellsInsideTheCylinderOnly) {
   LensCells c = cloud(20000);
   Hook h;
-  h.a = Vec3(-0.5, 0, 0);
+  h.a = h.bend = Vec3(-0.5, 0, 0);  // straight
   h.b = Vec3(0.5, 0.2, 0.3);
   h.velocity = Vec3(0, 40, -10);
   HookSettings s;
@@ -90,7 +91,7 @@ TEST(Hook, DragsCellsInsideTheCylinderOnly) {
 TEST(Hook, BlendDoesNotDependOnHowTheFrameIsSplit) {
   LensCells one = test::box_cells(1, Vec3::Zero(), Vec3::Zero()), two = one;
   Hook h;
-  h.a = Vec3(-1, 0, 0), h.b = Vec3(1, 0, 0), h.velocity = Vec3(10, 0, 0);
+  h.a = h.bend = Vec3(-1, 0, 0), h.b = Vec3(1, 0, 0), h.velocity = Vec3(10, 0, 0);
   HookSettings s;
   drag_with_hook(cell_spans(one), h, s, 0.01);
   drag_with_hook(cell_spans(two), h, s, 0.005);
@@ -103,13 +104,43 @@ TEST(Hook, FromPosesVelocityAndShaft) {
   ToolPose prev, now;
   prev.pos = Vec3(0, 0, 2);
   now.pos = Vec3(0.1, 0, 2);
-  now.quat = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()));  // shaft +z → +x
+  now.quat = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()));  // shaft +z → +x, bend +y stays
   HookSettings s;
   s.shaft_length_mm = 2.0;
   const Hook h = hook_from_poses(now, prev, 0.01, s);
   EXPECT_NEAR((h.velocity - Vec3(10, 0, 0)).norm(), 0, 1e-9);
-  EXPECT_NEAR((h.b - Vec3(2.1, 0, 2)).norm(), 0, 1e-12);
-  EXPECT_DOUBLE_EQ(distance_to_segment(Vec3(1, 0.3, 2), h.a, h.b), 0.3);
+  EXPECT_NEAR((h.a - now.pos).norm(), 0, 1e-12);
+  // The bent end: 1 mm along the instrument's −y from the shaft to the tip (tool_shape.hpp).
+  EXPECT_NEAR((h.bend - Vec3(0.1, 1, 2)).norm(), 0, 1e-12);
+  EXPECT_NEAR((h.b - Vec3(2.1, 1, 2)).norm(), 0, 1e-12);
+}
+
+// The hook drags what the drawn instrument passes through: its bent end and its shaft, which runs
+// 1 mm beside the tip (engine/io/tool_shape.hpp, as the rim press and the ports use), not a line
+// from the tip along the shaft's direction.
+TEST(Hook, DragsAlongTheBentEndAndTheShaftNotTheTipLine) {
+  const Quat q(Eigen::AngleAxisd(0.4, Vec3(1, 0.3, 0).normalized()));
+  ToolPose now;
+  now.pos = Vec3(0.2, -0.1, 0.5);
+  now.quat = q;
+  HookSettings s;  // radius 0.3 mm, shaft 1 mm
+  const Hook h = hook_from_poses(now, now, 0.01, s);
+  const Vec3 axis_point = shaft_axis(now, ToolKind::Hook).point;
+  const Vec3 up = q * Vec3::UnitZ();
+  LensCells c = test::box_cells(1, Vec3::Zero(), Vec3::Zero());
+  const auto dragged = [&](const Vec3& p) {
+    LensCells one = c;
+    one.x[0] = static_cast<float>(p.x()), one.y[0] = static_cast<float>(p.y());
+    one.z[0] = static_cast<float>(p.z());
+    Hook moving = h;
+    moving.velocity = Vec3(0, 0, 10);
+    drag_with_hook(cell_spans(one), moving, s, 0.01);
+    return one.vz[0] != 0.0f;
+  };
+  EXPECT_TRUE(dragged(0.5 * (now.pos + axis_point)));  // the middle of the bent end
+  EXPECT_TRUE(dragged(axis_point + 0.6 * up));         // on the shaft above the bend
+  EXPECT_FALSE(dragged(now.pos + 0.6 * up));           // the tip line: no instrument there
+  EXPECT_FALSE(dragged(now.pos + 0.6 * up + 0.1 * (q * Vec3::UnitX())));
 }
 
 TEST(Euler, FreeFallIsHalfGTSquaredToFirstOrder) {
@@ -180,7 +211,8 @@ TEST(CellDynamics, SameStateForOneTwoFourThreads) {
       for (int f = 0; f < 5; ++f) {
         aspirate(cell_spans(c), Aspirator{Vec3(0.5, 0, 0), 400}, AspiratorSettings{}, 0.01);
         Hook h;
-        h.a = Vec3(-1, -1, 0), h.b = Vec3(1, 1, 0), h.velocity = Vec3(0, 0, 20);
+        h.a = Vec3(-1, -1, 0), h.bend = Vec3(-1, -0.5, 0), h.b = Vec3(1, 1, 0);
+        h.velocity = Vec3(0, 0, 20);
         drag_with_hook(cell_spans(c), h, HookSettings{}, 0.01);
         integrate(cell_spans(c), Medium{}, 0.01);
       }
