@@ -315,26 +315,22 @@ void subcell_parents(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& 
 }
 
 // Sub-cell runs of octant o: the 27 sub-cells of edge h around the particle's sub-cell,
-// enumerated x fastest; a sub-cell whose slots follow the previous run's extends it.
+// enumerated x fastest (kSubcellSteps, grid.hpp); a sub-cell whose slots follow the previous
+// run's extends it.
 void subcell_octant(const Grid& g, int o, CellRuns& out) {
-  // Sub-cell coordinate of the octant relative to the parent block's lowest sub-cell (2 = own
-  // cell's lower half): s = 2 + bit, neighbours s − 1 … s + 1.
-  const int sx = 2 + (o & 1), sy = 2 + ((o >> 1) & 1), sz = 2 + ((o >> 2) & 1);
   int m = 0;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int ux = sx + dx, uy = sy + dy, uz = sz + dz;  // in [1, 4]
-        const uint32_t p = out.parent[((uz >> 1) * 3 + (uy >> 1)) * 3 + (ux >> 1)];
-        if (p == kNoSlot) continue;
-        const uint32_t so = static_cast<uint32_t>((ux & 1) | (uy & 1) << 1 | (uz & 1) << 2);
-        const Run r{g.sub_begin[8 * size_t{p} + so], g.sub_begin[8 * size_t{p} + so + 1]};
-        if (r.begin == r.end) continue;
-        if (m > 0 && out.runs[o][m - 1].end == r.begin)
-          out.runs[o][m - 1].end = r.end;
-        else
-          out.runs[o][m++] = r;
-      }
+  const uint32_t* sub = g.sub_begin.data();
+  for (const SubcellStep step : kSubcellSteps[o]) {
+    const uint32_t p = out.parent[step.parent];
+    if (p == kNoSlot) continue;
+    const size_t at = 8 * size_t{p} + step.octant;
+    const Run r{sub[at], sub[at + 1]};
+    if (r.begin == r.end) continue;
+    if (m > 0 && out.runs[o][m - 1].end == r.begin)
+      out.runs[o][m - 1].end = r.end;
+    else
+      out.runs[o][m++] = r;
+  }
   out.count[o] = static_cast<uint8_t>(m);
 }
 
