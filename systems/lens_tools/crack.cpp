@@ -50,17 +50,28 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
   const std::vector<uint32_t> near = parallel_reduce_ordered(
       0u, n, kCrackGrain, std::vector<uint32_t>{},
       [&](uint32_t b, uint32_t e) {
-        std::vector<uint32_t> ids;
+        // The box test without branches (cells lie in no order along x, so a branch per cell
+        // is mispredicted often): every index is written, the next write overwrites it unless
+        // the cell is in the box.
+        std::vector<uint32_t> ids(e - b + 1);
+        uint32_t k = 0;
         for (uint32_t i = b; i < e; ++i) {
-          if (!(c.x[i] >= lo.x() && c.x[i] <= hi.x())) continue;
-          if (!(c.y[i] >= lo.y() && c.y[i] <= hi.y() && c.z[i] >= lo.z() && c.z[i] <= hi.z()))
-            continue;
+          const float x = c.x[i], y = c.y[i], z = c.z[i];
+          ids[k] = i;
+          k += (x >= lo.x()) & (x <= hi.x()) & (y >= lo.y()) & (y <= hi.y()) & (z >= lo.z()) &
+               (z <= hi.z());
+        }
+        // The exact tests on the few in the box, in id order.
+        uint32_t kept = 0;
+        for (uint32_t j = 0; j < k; ++j) {
+          const uint32_t i = ids[j];
           if (!c.alive[i]) continue;
           const Vec3f x(c.x[i], c.y[i], c.z[i]);
           if ((x - p).squaredNorm() <= contact2 || (x - q).squaredNorm() <= contact2 ||
               (x - m).squaredNorm() < gap_r2)
-            ids.push_back(i);
+            ids[kept++] = i;
         }
+        ids.resize(kept);
         return ids;
       },
       [](std::vector<uint32_t> a, const std::vector<uint32_t>& b) {
