@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "engine/core/invariants.hpp"
@@ -52,8 +53,8 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
       [&](uint32_t b, uint32_t e) {
         // The box test without branches (cells lie in no order along x, so a branch per cell
         // is mispredicted often): every index is written, the next write overwrites it unless
-        // the cell is in the box.
-        std::vector<uint32_t> ids(e - b + 1);
+        // the cell is in the box. The buffer is not zeroed first (every entry read is written).
+        const auto ids = std::make_unique_for_overwrite<uint32_t[]>(e - b + 1);
         uint32_t k = 0;
         for (uint32_t i = b; i < e; ++i) {
           const float x = c.x[i], y = c.y[i], z = c.z[i];
@@ -71,8 +72,7 @@ CrackPush push_apart(const CrackCells& c, const Vec3& probe_tip, const Vec3& cho
               (x - m).squaredNorm() < gap_r2)
             ids[kept++] = i;
         }
-        ids.resize(kept);
-        return ids;
+        return std::vector<uint32_t>(ids.get(), ids.get() + kept);
       },
       [](std::vector<uint32_t> a, const std::vector<uint32_t>& b) {
         a.insert(a.end(), b.begin(), b.end());
