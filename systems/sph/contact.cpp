@@ -15,7 +15,7 @@ namespace phaco::sph {
 namespace {
 
 constexpr uint32_t kContactGrain = 256;
-constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the mixed-cell passes
+constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the fragment-range pass
 
 // ∫ u(1 − u²)² du = −(1 − u²)³/6, normalised by the peak u_p(1 − u_p²)², u_p = 1/√5; below
 // u_p the shape is 1.
@@ -53,15 +53,16 @@ struct ContactLaw {
   float h2, rp2, peak, push, damping;
 };
 
-// Per grid cell (sorted orders): whether its 3×3×3 block of cells (edge 2h, so every pair within
-// h of its particles) holds more than one fragment. Only such cells can have a contact pair.
-// With sub-cells, also each sub-cell's smallest and largest fragment (cell_lo/cell_hi from
-// index `cells` on, 8 per cell; empty: lo > hi), which single_fragment_octant reads.
-void mark_mixed_cells(const Grid& g, std::span<const uint32_t> fragment, ContactScratch& s) {
+// Per grid cell (sorted orders): its smallest and largest fragment (cell_lo/cell_hi); with
+// sub-cells, also each sub-cell's (from index `cells` on, 8 per cell; empty: lo > hi), which
+// single_fragment_octant reads. Whether a cell's 3×3×3 block holds more than one fragment
+// (cell_mixed) is decided in the contact pass from the neighbourhood it finds anyway for the
+// cell's particles (it was found twice for every mixed cell: here and there).
+void fragment_ranges(const Grid& g, std::span<const uint32_t> fragment, ContactScratch& s) {
   const auto cells = static_cast<uint32_t>(g.cell_key.size());
   const bool sub = !g.sub_begin.empty();
   const size_t ranges = sub ? size_t{9} * cells : cells;
-  s.cell_lo.resize(ranges), s.cell_hi.resize(ranges), s.mixed.resize(cells);
+  s.cell_lo.resize(ranges), s.cell_hi.resize(ranges);
   parallel_for(0, cells, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
       uint32_t lo = 0xffffffffu, hi = 0;
@@ -80,24 +81,23 @@ void mark_mixed_cells(const Grid& g, std::span<const uint32_t> fragment, Contact
       s.cell_lo[c] = lo, s.cell_hi[c] = hi;
     }
   });
-  parallel_for(0, cells, kCellGrain, [&](uint32_t b, uint32_t e, int) {
-    CellRuns near;
-    for (uint32_t c = b; c < e; ++c) {
-      const uint32_t f = s.cell_lo[c];
-      bool mixed = s.cell_hi[c] != f;
-      cell_neighbourhood(g, c, near);
-      for (int k = 0; k < 27 && !mixed; ++k) {
-        uint32_t other = kNoSlot;
-        if (near.subcells) {
-          other = near.parent[k];
-        } else if (near.block[k].begin != near.block[k].end) {
-          other = g.slot_cell[near.block[k].begin];
-        }
-        mixed = other != kNoSlot && (s.cell_lo[other] != f || s.cell_hi[other] != f);
-      }
-      s.mixed[c] = mixed;
+}
+
+// Whether the 3×3×3 block of cells around `cell` (edge 2h, so every pair within h of its
+// particles) holds more than one fragment. Only such a cell can have a contact pair.
+bool cell_mixed(const Grid& g, const ContactScratch& s, uint32_t cell, const CellRuns& near) {
+  const uint32_t f = s.cell_lo[cell];
+  if (s.cell_hi[cell] != f) return true;
+  for (int k = 0; k < 27; ++k) {
+    uint32_t other = kNoSlot;
+    if (near.subcells) {
+      other = near.parent[k];
+    } else if (near.block[k].begin != near.block[k].end) {
+      other = g.slot_cell[near.block[k].begin];
     }
-  });
+    if (other != kNoSlot && (s.cell_lo[other] != f || s.cell_hi[other] != f)) return true;
+  }
+  return false;
 }
 
 // Sub-cell grids: whether the 27 sub-cells a particle of octant o of `cell` scans (all its
@@ -210,7 +210,7 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
   const ContactLaw law(params);
   uint64_t twice = 0;
   if (sorted) {
-    mark_mixed_cells(g, in.fragment, scratch);
+    fragment_ranges(g, in.fragment, scratch);
     // Fragment labels in slot order, padded like the positions (the last block reads past the
     // end; those lanes are masked).
     scratch.fragment_slot.resize(size_t{g.count} + kPad);
@@ -226,7 +226,7 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
           for (uint32_t s = b; s < e;) {
             const uint32_t cell = g.slot_cell[s];
             const uint32_t to = std::min(e, g.cell_begin[cell + 1]);
-            if (scratch.mixed[cell])
+            if (cell_mixed(g, scratch, cell, candidates.neighbourhood(s)))
               pairs += contact_slots(g, in, scratch, law, candidates, s, to, fx.data(), fy.data(),
                                      fz.data());
             s = to;
