@@ -200,12 +200,13 @@ namespace {
 // soft to keep fragments apart; the bounded move is stable at any stiffness, and the pushed cells
 // weigh heavily in the shape match, so the fragment as a whole takes the push.
 void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
-  std::fill(l.pushed.begin(), l.pushed.end(), uint8_t{0});
+  // The last call's forces and pushes lie on its contact grid's members only (fragment_contact
+  // adds to those, the loop below pushes those; make_fragment_lens zeroed all): cleared there
+  // instead of over every cell.
+  for (const uint32_t c : l.contact_scratch.members)
+    l.pushed[c] = 0, l.fx[c] = 0.0f, l.fy[c] = 0.0f, l.fz[c] = 0.0f;
   if (l.fragments.count < 2) return;  // one body: no fragment contact to compute
   mark_boundary(l);
-  std::fill(l.fx.begin(), l.fx.end(), 0.0f);
-  std::fill(l.fy.begin(), l.fy.end(), 0.0f);
-  std::fill(l.fz.begin(), l.fz.end(), 0.0f);
   const sph::ContactParticles p{l.cells.x, l.cells.y, l.cells.z,         l.vx,
                                 l.vy,      l.vz,      l.fragments.label, l.boundary};
   const sph::ContactStats cs = sph::fragment_contact(p, l.fragments.count, l.settings.contact,

@@ -173,11 +173,12 @@ void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
   g.cell = 2.0 * static_cast<double>(h) * (1.0 + kCellMargin);
   g.count = n;
   g.id.resize(n);
-  // Padded so that an 8-wide block may read past the last slot (the reads are masked).
-  g.x.assign(n + kPad, 0.0f);
-  g.y.assign(n + kPad, 0.0f);
-  g.z.assign(n + kPad, 0.0f);
-  g.m.assign(n + kPad, 0.0f);
+  // Padded so that an 8-wide block may read past the last slot (the reads are masked). Slots
+  // below n are all written below: only the padding is zeroed.
+  for (std::vector<float>* v : {&g.x, &g.y, &g.z, &g.m}) {
+    v->resize(n + kPad);
+    std::fill(v->begin() + n, v->end(), 0.0f);
+  }
   g.octant.resize(n);
   g.coord.resize(n);
   g.key.resize(n);
