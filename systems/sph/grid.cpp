@@ -293,6 +293,19 @@ namespace {
 
 // Sub-cell grids: the 27 cells around `c` (kNoSlot where empty).
 void subcell_parents(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& out) {
+  // With the dense table, a cell off the box's faces (the usual case: the box has an empty layer
+  // below its particles and one above) has its 27 neighbours inside, at fixed steps of the
+  // linear key from the lowest one: the same entries as the lookups below, without the tests.
+  if (!g.dense_cell.empty() && c[0] >= 1 && c[1] >= 1 && c[2] >= 1 && c[0] + 1 < g.dims[0] &&
+      c[1] + 1 < g.dims[1] && c[2] + 1 < g.dims[2]) {
+    const size_t sy = g.dims[0], sz = size_t{g.dims[0]} * g.dims[1];
+    const uint32_t* lowest = g.dense_cell.data() + linear_key(g, c[0] - 1, c[1] - 1, c[2] - 1);
+    for (int dz = 0; dz < 3; ++dz)
+      for (int dy = 0; dy < 3; ++dy)
+        for (int dx = 0; dx < 3; ++dx)
+          out.parent[(dz * 3 + dy) * 3 + dx] = lowest[dz * sz + dy * sy + dx];
+    return;
+  }
   for (int dz = 0; dz < 3; ++dz)
     for (int dy = 0; dy < 3; ++dy)
       for (int dx = 0; dx < 3; ++dx) {
