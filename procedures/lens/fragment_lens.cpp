@@ -11,8 +11,9 @@
 namespace phaco::lens {
 namespace {
 
-constexpr uint32_t kCellGrain = 4096;  // per-cell passes: chunks of cells, in parallel
-constexpr uint32_t kRegionBins = 32;   // contact regions' bins per axis (mark_boundary)
+constexpr uint32_t kCellGrain = 4096;         // per-cell passes: chunks of cells, in parallel
+constexpr uint32_t kRegionBins = 32;          // contact regions' bins per axis (mark_boundary)
+constexpr float kCaptureBoxMarginMm = 1e-3f;  // the box around the port's capture ball
 
 // Fragments per chunk of a pass over fragments: about kCellGrain cells (as shape matching).
 uint32_t fragment_grain(const FragmentLens& l) {
@@ -34,24 +35,20 @@ CellSpans spans(FragmentLens& l) {
 void mark_boundary(FragmentLens& l) {
   const uint32_t n = l.cells.size(), nf = l.fragments.count;
   const float h = l.settings.contact.h;
-  parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
-    for (uint32_t c = b; c < e; ++c) {
-      uint8_t ext = 0;
-      if (l.cells.alive[c]) {
-        for (uint32_t k = 0; k < 4; ++k) ext |= l.cells.neighbour[c][k] == kNoSimplex;
-      }
-      l.boundary[c] = ext;
-    }
-  });
   auto& box = l.fragment_box;  // per fragment: min x, y, z, max x, y, z of its boundary cells
   box.assign(nf, {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f});
-  // Per fragment over its members (min and max are exact: any order gives the same box).
+  // Per fragment over its members, the alive cells (min and max are exact: any order gives the
+  // same box): which have an external face (boundary, for now), and the box of those. Removed
+  // cells are no member: the last pass below clears their flags.
   parallel_for(0, nf, fragment_grain(l), [&](uint32_t fb, uint32_t fe, int) {
     for (uint32_t f = fb; f < fe; ++f) {
       auto& bx = box[f];
       for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
         const uint32_t c = l.fragments.members[k];
-        if (!l.boundary[c]) continue;
+        uint8_t ext = 0;
+        for (uint32_t j = 0; j < 4; ++j) ext |= l.cells.neighbour[c][j] == kNoSimplex;
+        l.boundary[c] = ext;
+        if (!ext) continue;
         const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
         for (int a = 0; a < 3; ++a)
           bx[a] = std::min(bx[a], p[a] - h), bx[a + 3] = std::max(bx[a + 3], p[a] + h);
@@ -119,7 +116,10 @@ void mark_boundary(FragmentLens& l) {
     each_bin(overlaps[k].second, [&](uint32_t b) { items[fill[b]++] = k; });
   parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
-      if (!l.boundary[c]) continue;
+      if (!l.boundary[c] || !l.cells.alive[c]) {
+        l.boundary[c] = 0;
+        continue;
+      }
       const uint32_t f = l.fragments.label[c];
       const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
       uint8_t in = 0;
@@ -200,12 +200,13 @@ namespace {
 // soft to keep fragments apart; the bounded move is stable at any stiffness, and the pushed cells
 // weigh heavily in the shape match, so the fragment as a whole takes the push.
 void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
-  std::fill(l.pushed.begin(), l.pushed.end(), uint8_t{0});
+  // The last call's forces and pushes lie on its contact grid's members only (fragment_contact
+  // adds to those, the loop below pushes those; make_fragment_lens zeroed all): cleared there
+  // instead of over every cell.
+  for (const uint32_t c : l.contact_scratch.members)
+    l.pushed[c] = 0, l.fx[c] = 0.0f, l.fy[c] = 0.0f, l.fz[c] = 0.0f;
   if (l.fragments.count < 2) return;  // one body: no fragment contact to compute
   mark_boundary(l);
-  std::fill(l.fx.begin(), l.fx.end(), 0.0f);
-  std::fill(l.fy.begin(), l.fy.end(), 0.0f);
-  std::fill(l.fz.begin(), l.fz.end(), 0.0f);
   const sph::ContactParticles p{l.cells.x, l.cells.y, l.cells.z,         l.vx,
                                 l.vy,      l.vz,      l.fragments.label, l.boundary};
   const sph::ContactStats cs = sph::fragment_contact(p, l.fragments.count, l.settings.contact,
@@ -228,7 +229,59 @@ void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
   }
 }
 
-void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s) {
+// The rigid fit can set a cell back out of the bag (by over a millimetre when a crack's halves
+// push apart against the wall). With fluidics (the drill that fails on a capsule breach) a cell
+// the fit left further out than the lens at rest stands out of the bag (its shoulders, up to
+// 0.33 mm with the equator fit, constraints.hpp) is brought back to that distance: fragments
+// never leave through the wall, and the resting lens is not squeezed.
+constexpr double kRestOverlapMm = 0.35;
+
+// The leash of one alive cell: when it lies more than `leash_mm` out of the bag (the opening
+// allowed), it is moved back to `leash_mm` out along the way to its projection
+// (lens_tools::constrain on the one cell). It reads and writes that cell's position only, so it
+// runs in shape matching's write-back, right after the cell's position is written (one pass over
+// the cells instead of two, the same positions as a pass of its own after it).
+struct BagLeash {
+  const lens_tools::EyeBounds& bounds;
+  double leash_mm;
+  lens_tools::SurelyInside sure;
+  BagLeash(const lens_tools::EyeBounds& b, double leash)
+      : bounds(b), leash_mm(leash), sure(b, leash) {}
+  // SurelyInside's test with its float operations, without a branch per ball (most cells are
+  // well inside; the branches of the short-circuit tests were mispredicted often).
+  static bool in_ball(const lens_tools::SurelyInside::FloatBall& b, float x, float y, float z) {
+    const float dx = x - b.cx, dy = y - b.cy, dz = z - b.cz;
+    return !b.present | (dx * dx + dy * dy + dz * dz <= b.r2);
+  }
+  bool surely_inside(float x, float y, float z) const {
+    const bool open = (sure.open2 >= 0) & (x * x + y * y < sure.open2);
+    return (open | in_ball(sure.anterior, x, y, z)) & in_ball(sure.posterior, x, y, z) &
+           in_ball(sure.cornea, x, y, z);
+  }
+  void operator()(FragmentLens& l, uint32_t c) const {
+    if (surely_inside(l.cells.x[c], l.cells.y[c], l.cells.z[c])) return;
+    pull_back(l, c);
+  }
+  [[gnu::noinline]] void pull_back(FragmentLens& l, uint32_t c) const {
+    const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+    if (lens_tools::inside_bounds(p, bounds, leash_mm)) return;
+    float x = l.cells.x[c], y = l.cells.y[c], z = l.cells.z[c], vx = 0, vy = 0, vz = 0;
+    const float mass = l.cells.mass[c], hardness = 0;
+    const uint8_t alive = 1;
+    const CellSpans one{{&x, 1},  {&y, 1},    {&z, 1},     {&vx, 1},      {&vy, 1},
+                        {&vz, 1}, {&mass, 1}, {&alive, 1}, {&hardness, 1}};
+    lens_tools::constrain(one, bounds, {});
+    const Vec3 q(x, y, z), out = p - q;
+    const double len = out.norm();
+    if (!(len > leash_mm)) return;
+    const Vec3 r = q + out * (leash_mm / len);
+    l.cells.x[c] = static_cast<float>(r.x()), l.cells.y[c] = static_cast<float>(r.y()),
+    l.cells.z[c] = static_cast<float>(r.z());
+  }
+};
+
+void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s,
+                  const std::optional<BagLeash>& leash) {
   const uint32_t n = l.cells.size();
   parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
@@ -250,34 +303,7 @@ void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s) {
       l.cells.x[c] = l.current[c].x(), l.cells.y[c] = l.current[c].y(),
       l.cells.z[c] = l.current[c].z();
       l.vx[c] += d.x() * inv_dt, l.vy[c] += d.y() * inv_dt, l.vz[c] += d.z() * inv_dt;
-    }
-  });
-}
-
-constexpr double kRestOverlapMm = 0.35;
-
-// Cells more than `leash_mm` out of the bag (the opening allowed) are moved back to `leash_mm` out
-// along the way to their projection (lens_tools::constrain on the one cell).
-void leash_to_bag(FragmentLens& l, double leash_mm) {
-  const lens_tools::EyeBounds& b = l.settings.bounds;
-  const lens_tools::SurelyInside sure(b, leash_mm);
-  parallel_for(0, l.cells.size(), kCellGrain, [&](uint32_t cb, uint32_t ce, int) {
-    for (uint32_t c = cb; c < ce; ++c) {
-      if (!l.cells.alive[c] || sure(l.cells.x[c], l.cells.y[c], l.cells.z[c])) continue;
-      const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
-      if (lens_tools::inside_bounds(p, b, leash_mm)) continue;
-      float x = l.cells.x[c], y = l.cells.y[c], z = l.cells.z[c], vx = 0, vy = 0, vz = 0;
-      const float mass = l.cells.mass[c], hardness = 0;
-      const uint8_t alive = 1;
-      const CellSpans one{{&x, 1},  {&y, 1},    {&z, 1},     {&vx, 1},      {&vy, 1},
-                          {&vz, 1}, {&mass, 1}, {&alive, 1}, {&hardness, 1}};
-      lens_tools::constrain(one, b, {});
-      const Vec3 q(x, y, z), out = p - q;
-      const double len = out.norm();
-      if (!(len > leash_mm)) continue;
-      const Vec3 r = q + out * (leash_mm / len);
-      l.cells.x[c] = static_cast<float>(r.x()), l.cells.y[c] = static_cast<float>(r.y()),
-      l.cells.z[c] = static_cast<float>(r.z());
+      if (leash) (*leash)(l, c);
     }
   });
 }
@@ -436,8 +462,15 @@ FragmentLensStats step_fragment_lens(FragmentLens& l, const LensTools& tools, co
                                        std::pow(l.settings.fluid.port_radius_mm, 3)
                                  : std::numeric_limits<double>::infinity();
     const uint32_t before = static_cast<uint32_t>(l.removed.size());
+    // A cell farther than the capture radius from the port along one axis (the radius widened by
+    // kCaptureBoxMarginMm, ≫ float rounding of d²) is outside the ball: rejected before the rest.
+    const float box = static_cast<float>(capture) + kCaptureBoxMarginMm;
     lens_tools::detail::collect_ids(
         l.cells.size(), l.scan_ids, l.scan_counts, l.scan_hits, [&](uint32_t c) {
+          if (!(std::abs(l.cells.x[c] - port.x()) <= box)) return false;
+          if (!(std::abs(l.cells.y[c] - port.y()) <= box &&
+                std::abs(l.cells.z[c] - port.z()) <= box))
+            return false;
           if (!l.cells.alive[c]) return false;
           const Vec3f d = Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]) - port;
           return d.squaredNorm() < r2 && l.fragments.mass[l.fragments.label[c]] <= passes_kg &&
@@ -472,13 +505,10 @@ FragmentLensStats step_fragment_lens(FragmentLens& l, const LensTools& tools, co
   apply_contact(l, st, dt_s);
   // 5. constraints, 6. shape matching
   lens_tools::constrain(cells, l.settings.bounds, l.contact);
-  match_shapes(l, st, dt_s);
-  // The rigid fit can set a cell back out of the bag (by over a millimetre when a crack's halves
-  // push apart against the wall). With fluidics (the drill that fails on a capsule breach) a cell
-  // the fit left further out than the lens at rest stands out of the bag (its shoulders, up to
-  // 0.33 mm with the equator fit, constraints.hpp) is brought back to that distance: fragments
-  // never leave through the wall, and the resting lens is not squeezed.
-  if (fluidics) leash_to_bag(l, kRestOverlapMm);
+  // ... and with fluidics each cell leashed to the bag as its position is written (BagLeash).
+  std::optional<BagLeash> leash;
+  if (fluidics) leash.emplace(l.settings.bounds, kRestOverlapMm);
+  match_shapes(l, st, dt_s, leash);
   return st;
 }
 

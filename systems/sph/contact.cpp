@@ -15,7 +15,7 @@ namespace phaco::sph {
 namespace {
 
 constexpr uint32_t kContactGrain = 256;
-constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the mixed-cell passes
+constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the fragment-range pass
 
 // ∫ u(1 − u²)² du = −(1 − u²)³/6, normalised by the peak u_p(1 − u_p²)², u_p = 1/√5; below
 // u_p the shape is 1.
@@ -27,37 +27,94 @@ double shape_integral(double from) {
   return tail + std::max(0.0, up - from);                     // + ∫_from^up of 1
 }
 
-// Per grid cell (sorted orders): whether its 3×3×3 block of cells (edge 2h, so every pair within
-// h of its particles) holds more than one fragment. Only such cells can have a contact pair.
-void mark_mixed_cells(const Grid& g, std::span<const uint32_t> fragment, ContactScratch& s) {
+// The pair force's scalar (contact.hpp): f_ij = max(0, k·h − c·v_n) · ĝ(r) · n̂ as s · (x_i − x_j).
+// What depends on the parameters alone (h², (h/√5)², the peak's denominator, k·h) is computed once
+// per call of fragment_contact instead of once per pair, by the same float operations in the same
+// order, so s has the same bits as computed per pair.
+struct ContactLaw {
+  explicit ContactLaw(const ContactParams& p)
+      : h2(p.h * p.h),
+        rp2(h2 * 0.2f),  // (h/√5)²
+        peak(std::sqrt(rp2) * (h2 - rp2) * (h2 - rp2)),
+        push(p.stiffness * p.h),
+        damping(p.damping) {}
+  float operator()(float r2, float vdotd) const {
+    if (!(r2 > 0.0f)) return 0.0f;  // coincident (or NaN): no direction
+    if (r2 >= h2) return 0.0f;
+    const float r = std::sqrt(r2);
+    const float rc2 = std::max(r2, rp2);
+    const float rc = std::sqrt(rc2);
+    const float dc = h2 - rc2;
+    const float shape = (rc * dc * dc) / peak;  // ĝ(r) ∈ [0, 1]
+    const float vn = vdotd / r;                 // < 0 when approaching
+    const float magnitude = std::max(0.0f, push - damping * vn) * shape;
+    return magnitude / r;
+  }
+  float h2, rp2, peak, push, damping;
+};
+
+// Per grid cell (sorted orders): its smallest and largest fragment (cell_lo/cell_hi); with
+// sub-cells, also each sub-cell's (from index `cells` on, 8 per cell; empty: lo > hi), which
+// single_fragment_octant reads. Whether a cell's 3×3×3 block holds more than one fragment
+// (cell_mixed) is decided in the contact pass from the neighbourhood it finds anyway for the
+// cell's particles (it was found twice for every mixed cell: here and there).
+void fragment_ranges(const Grid& g, std::span<const uint32_t> fragment, ContactScratch& s) {
   const auto cells = static_cast<uint32_t>(g.cell_key.size());
-  s.cell_lo.resize(cells), s.cell_hi.resize(cells), s.mixed.resize(cells);
+  const bool sub = !g.sub_begin.empty();
+  const size_t ranges = sub ? size_t{9} * cells : cells;
+  s.cell_lo.resize(ranges), s.cell_hi.resize(ranges);
   parallel_for(0, cells, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
       uint32_t lo = 0xffffffffu, hi = 0;
-      for (uint32_t k = g.cell_begin[c]; k < g.cell_begin[c + 1]; ++k)
-        lo = std::min(lo, fragment[g.id[k]]), hi = std::max(hi, fragment[g.id[k]]);
+      if (sub) {
+        for (uint32_t o = 0; o < 8; ++o) {
+          uint32_t slo = 0xffffffffu, shi = 0;
+          for (uint32_t k = g.sub_begin[8 * c + o]; k < g.sub_begin[8 * c + o + 1]; ++k)
+            slo = std::min(slo, fragment[g.id[k]]), shi = std::max(shi, fragment[g.id[k]]);
+          s.cell_lo[cells + 8 * c + o] = slo, s.cell_hi[cells + 8 * c + o] = shi;
+          lo = std::min(lo, slo), hi = std::max(hi, shi);
+        }
+      } else {
+        for (uint32_t k = g.cell_begin[c]; k < g.cell_begin[c + 1]; ++k)
+          lo = std::min(lo, fragment[g.id[k]]), hi = std::max(hi, fragment[g.id[k]]);
+      }
       s.cell_lo[c] = lo, s.cell_hi[c] = hi;
     }
   });
-  parallel_for(0, cells, kCellGrain, [&](uint32_t b, uint32_t e, int) {
-    CellRuns near;
-    for (uint32_t c = b; c < e; ++c) {
-      const uint32_t f = s.cell_lo[c];
-      bool mixed = s.cell_hi[c] != f;
-      cell_neighbourhood(g, c, near);
-      for (int k = 0; k < 27 && !mixed; ++k) {
-        uint32_t other = kNoSlot;
-        if (near.subcells) {
-          other = near.parent[k];
-        } else if (near.block[k].begin != near.block[k].end) {
-          other = g.slot_cell[near.block[k].begin];
-        }
-        mixed = other != kNoSlot && (s.cell_lo[other] != f || s.cell_hi[other] != f);
-      }
-      s.mixed[c] = mixed;
+}
+
+// Whether the 3×3×3 block of cells around `cell` (edge 2h, so every pair within h of its
+// particles) holds more than one fragment. Only such a cell can have a contact pair.
+bool cell_mixed(const Grid& g, const ContactScratch& s, uint32_t cell, const CellRuns& near) {
+  const uint32_t f = s.cell_lo[cell];
+  if (s.cell_hi[cell] != f) return true;
+  for (int k = 0; k < 27; ++k) {
+    uint32_t other = kNoSlot;
+    if (near.subcells) {
+      other = near.parent[k];
+    } else if (near.block[k].begin != near.block[k].end) {
+      other = g.slot_cell[near.block[k].begin];
     }
-  });
+    if (other != kNoSlot && (s.cell_lo[other] != f || s.cell_hi[other] != f)) return true;
+  }
+  return false;
+}
+
+// Sub-cell grids: whether the 27 sub-cells a particle of octant o of `cell` scans (all its
+// candidates) hold one fragment only, its own. Such a particle has no pair: its sums stay +0, so
+// skipping it leaves the same bits (as for a cell that is not mixed, one level finer). Decided
+// once per octant from the sub-cells' fragment ranges, instead of per particle over the
+// candidates.
+bool single_fragment_octant(const ContactScratch& s, uint32_t cells, uint32_t cell, int o,
+                            const CellRuns& near) {
+  const uint32_t f = s.cell_lo[cells + 8 * size_t{cell} + o];
+  for (const SubcellStep step : kSubcellSteps[o]) {
+    const uint32_t p = near.parent[step.parent];
+    if (p == kNoSlot) continue;
+    const size_t at = cells + 8 * size_t{p} + step.octant;
+    if (s.cell_lo[at] <= s.cell_hi[at] && (s.cell_lo[at] != f || s.cell_hi[at] != f)) return false;
+  }
+  return true;
 }
 
 // The contact sums of slots [from, to) (one grid cell's; sorted orders). Eight candidates at a
@@ -70,9 +127,9 @@ void mark_mixed_cells(const Grid& g, std::span<const uint32_t> fragment, Contact
 __attribute__((target_clones("avx2", "default")))
 #endif
 uint64_t
-contact_slots(const Grid& g, const ContactParticles& in, const uint32_t* fragment_slot,
-              const ContactParams& params, Candidates& candidates, uint32_t from, uint32_t to,
-              float* fx, float* fy, float* fz) {
+contact_slots(const Grid& g, const ContactParticles& in, const ContactScratch& scratch,
+              const ContactLaw& law, Candidates& candidates, uint32_t from, uint32_t to, float* fx,
+              float* fy, float* fz) {
   using simd8::F8;
   using simd8::I8;
   using simd8::load8;
@@ -80,8 +137,22 @@ contact_slots(const Grid& g, const ContactParticles& in, const uint32_t* fragmen
   const float* X = g.x.data();
   const float* Y = g.y.data();
   const float* Z = g.z.data();
+  const uint32_t* fragment_slot = scratch.fragment_slot.data();
+  const bool sub = !g.sub_begin.empty();
+  const auto cells = static_cast<uint32_t>(g.cell_key.size());
+  uint8_t decided = 0, single = 0;  // per octant of the cell (single_fragment_octant)
   uint64_t pairs = 0;
   for (uint32_t i = from; i < to; ++i) {
+    if (sub) {
+      const int o = g.octant[i];
+      const auto bit = static_cast<uint8_t>(1u << o);
+      if (!(decided & bit)) {
+        decided |= bit;
+        if (single_fragment_octant(scratch, cells, g.slot_cell[i], o, candidates.neighbourhood(i)))
+          single |= bit;
+      }
+      if (single & bit) continue;
+    }
     const uint32_t pi = g.id[i];
     const float xs = g.x[i], ys = g.y[i], zs = g.z[i];
     const F8 xi = simd8::splat(xs), yi = simd8::splat(ys), zi = simd8::splat(zs);
@@ -98,7 +169,7 @@ contact_slots(const Grid& g, const ContactParticles& in, const uint32_t* fragmen
           const uint32_t pj = g.id[j + l];
           const float vd = (in.vx[pi] - in.vx[pj]) * dx[l] + (in.vy[pi] - in.vy[pj]) * dy[l] +
                            (in.vz[pi] - in.vz[pj]) * dz[l];
-          const float s = pair_force_scale(params, r2[l], vd);
+          const float s = law(r2[l], vd);
           sx += s * dx[l];
           sy += s * dy[l];
           sz += s * dz[l];
@@ -116,19 +187,7 @@ contact_slots(const Grid& g, const ContactParticles& in, const uint32_t* fragmen
 }  // namespace
 
 float pair_force_scale(const ContactParams& p, float r2, float vdotd) {
-  if (!(r2 > 0.0f)) return 0.0f;  // coincident (or NaN): no direction
-  const float h2 = p.h * p.h;
-  if (r2 >= h2) return 0.0f;
-  const float r = std::sqrt(r2);
-  const float rp2 = h2 * 0.2f;  // (h/√5)²
-  const float rc2 = std::max(r2, rp2);
-  const float rc = std::sqrt(rc2);
-  const float dp = h2 - rp2;
-  const float dc = h2 - rc2;
-  const float shape = (rc * dc * dc) / (std::sqrt(rp2) * dp * dp);  // ĝ(r) ∈ [0, 1]
-  const float vn = vdotd / r;                                       // < 0 when approaching
-  const float magnitude = std::max(0.0f, p.stiffness * p.h - p.damping * vn) * shape;
-  return magnitude / r;
+  return ContactLaw(p)(r2, vdotd);
 }
 
 ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_count,
@@ -148,9 +207,10 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
   build_grid(g, in.x, in.y, in.z, {}, params.h, params.order, scratch.members);
 
   const bool sorted = params.order != CellOrder::UnsortedHash;
+  const ContactLaw law(params);
   uint64_t twice = 0;
   if (sorted) {
-    mark_mixed_cells(g, in.fragment, scratch);
+    fragment_ranges(g, in.fragment, scratch);
     // Fragment labels in slot order, padded like the positions (the last block reads past the
     // end; those lanes are masked).
     scratch.fragment_slot.resize(size_t{g.count} + kPad);
@@ -166,9 +226,9 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
           for (uint32_t s = b; s < e;) {
             const uint32_t cell = g.slot_cell[s];
             const uint32_t to = std::min(e, g.cell_begin[cell + 1]);
-            if (scratch.mixed[cell])
-              pairs += contact_slots(g, in, scratch.fragment_slot.data(), params, candidates, s, to,
-                                     fx.data(), fy.data(), fz.data());
+            if (cell_mixed(g, scratch, cell, candidates.neighbourhood(s)))
+              pairs += contact_slots(g, in, scratch, law, candidates, s, to, fx.data(), fy.data(),
+                                     fz.data());
             s = to;
           }
           return pairs;
@@ -187,7 +247,7 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
                 if (in.fragment[pj] == in.fragment[pi]) return;
                 const float vd = (in.vx[pi] - in.vx[pj]) * dx + (in.vy[pi] - in.vy[pj]) * dy +
                                  (in.vz[pi] - in.vz[pj]) * dz;
-                const float s = pair_force_scale(params, r2, vd);
+                const float s = law(r2, vd);
                 sx += s * dx;
                 sy += s * dy;
                 sz += s * dz;

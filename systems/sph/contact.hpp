@@ -23,7 +23,9 @@
 // Scope (DESIGN §3: model no more than the scene needs): with fewer than two fragments the call
 // returns at once; otherwise only particles flagged boundary enter the grid, and only the grid
 // cells whose 3×3×3 block of cells (edge 2h) holds two fragments or more are scanned (a particle
-// elsewhere has no pair: skipping it adds nothing, so the forces are the same bits).
+// elsewhere has no pair: skipping it adds nothing, so the forces are the same bits); within those,
+// with sub-cells, a particle whose 27 sub-cells hold its own fragment only is skipped too (the same
+// argument one level finer, decided once per cell and octant).
 //
 // Reads: positions, velocities, fragment labels, boundary flags. Writes: forces (added, mN).
 #include <cstdint>
@@ -50,10 +52,14 @@ struct ContactParticles {
 
 struct ContactScratch {
   Grid grid;
-  std::vector<uint32_t> members;           // boundary particles
-  std::vector<uint32_t> cell_lo, cell_hi;  // per grid cell: smallest and largest fragment in it
-  std::vector<uint8_t> mixed;              // per grid cell: another fragment in its 3×3×3 block
-  std::vector<uint32_t> fragment_slot;     // per slot (+ kPad): the fragment label
+  std::vector<uint32_t> members;  // boundary particles
+  // Per grid cell: smallest and largest fragment in it; with sub-cells, then per sub-cell (8 a
+  // cell, from index cells on).
+  std::vector<uint32_t> cell_lo, cell_hi;
+  // Unused (the contact pass decides per cell whether its block holds two fragments): kept
+  // for now so that ContactScratch, inside FragmentLens, keeps its layout; to be removed.
+  std::vector<uint8_t> mixed;
+  std::vector<uint32_t> fragment_slot;  // per slot (+ kPad): the fragment label
 };
 
 struct ContactStats {

@@ -173,11 +173,12 @@ void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
   g.cell = 2.0 * static_cast<double>(h) * (1.0 + kCellMargin);
   g.count = n;
   g.id.resize(n);
-  // Padded so that an 8-wide block may read past the last slot (the reads are masked).
-  g.x.assign(n + kPad, 0.0f);
-  g.y.assign(n + kPad, 0.0f);
-  g.z.assign(n + kPad, 0.0f);
-  g.m.assign(n + kPad, 0.0f);
+  // Padded so that an 8-wide block may read past the last slot (the reads are masked). Slots
+  // below n are all written below: only the padding is zeroed.
+  for (std::vector<float>* v : {&g.x, &g.y, &g.z, &g.m}) {
+    v->resize(n + kPad);
+    std::fill(v->begin() + n, v->end(), 0.0f);
+  }
   g.octant.resize(n);
   g.coord.resize(n);
   g.key.resize(n);
@@ -292,6 +293,19 @@ namespace {
 
 // Sub-cell grids: the 27 cells around `c` (kNoSlot where empty).
 void subcell_parents(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& out) {
+  // With the dense table, a cell off the box's faces (the usual case: the box has an empty layer
+  // below its particles and one above) has its 27 neighbours inside, at fixed steps of the
+  // linear key from the lowest one: the same entries as the lookups below, without the tests.
+  if (!g.dense_cell.empty() && c[0] >= 1 && c[1] >= 1 && c[2] >= 1 && c[0] + 1 < g.dims[0] &&
+      c[1] + 1 < g.dims[1] && c[2] + 1 < g.dims[2]) {
+    const size_t sy = g.dims[0], sz = size_t{g.dims[0]} * g.dims[1];
+    const uint32_t* lowest = g.dense_cell.data() + linear_key(g, c[0] - 1, c[1] - 1, c[2] - 1);
+    for (int dz = 0; dz < 3; ++dz)
+      for (int dy = 0; dy < 3; ++dy)
+        for (int dx = 0; dx < 3; ++dx)
+          out.parent[(dz * 3 + dy) * 3 + dx] = lowest[dz * sz + dy * sy + dx];
+    return;
+  }
   for (int dz = 0; dz < 3; ++dz)
     for (int dy = 0; dy < 3; ++dy)
       for (int dx = 0; dx < 3; ++dx) {
@@ -315,26 +329,22 @@ void subcell_parents(const Grid& g, const std::array<uint32_t, 3>& c, CellRuns& 
 }
 
 // Sub-cell runs of octant o: the 27 sub-cells of edge h around the particle's sub-cell,
-// enumerated x fastest; a sub-cell whose slots follow the previous run's extends it.
+// enumerated x fastest (kSubcellSteps, grid.hpp); a sub-cell whose slots follow the previous
+// run's extends it.
 void subcell_octant(const Grid& g, int o, CellRuns& out) {
-  // Sub-cell coordinate of the octant relative to the parent block's lowest sub-cell (2 = own
-  // cell's lower half): s = 2 + bit, neighbours s − 1 … s + 1.
-  const int sx = 2 + (o & 1), sy = 2 + ((o >> 1) & 1), sz = 2 + ((o >> 2) & 1);
   int m = 0;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int ux = sx + dx, uy = sy + dy, uz = sz + dz;  // in [1, 4]
-        const uint32_t p = out.parent[((uz >> 1) * 3 + (uy >> 1)) * 3 + (ux >> 1)];
-        if (p == kNoSlot) continue;
-        const uint32_t so = static_cast<uint32_t>((ux & 1) | (uy & 1) << 1 | (uz & 1) << 2);
-        const Run r{g.sub_begin[8 * size_t{p} + so], g.sub_begin[8 * size_t{p} + so + 1]};
-        if (r.begin == r.end) continue;
-        if (m > 0 && out.runs[o][m - 1].end == r.begin)
-          out.runs[o][m - 1].end = r.end;
-        else
-          out.runs[o][m++] = r;
-      }
+  const uint32_t* sub = g.sub_begin.data();
+  for (const SubcellStep step : kSubcellSteps[o]) {
+    const uint32_t p = out.parent[step.parent];
+    if (p == kNoSlot) continue;
+    const size_t at = 8 * size_t{p} + step.octant;
+    const Run r{sub[at], sub[at + 1]};
+    if (r.begin == r.end) continue;
+    if (m > 0 && out.runs[o][m - 1].end == r.begin)
+      out.runs[o][m - 1].end = r.end;
+    else
+      out.runs[o][m++] = r;
+  }
   out.count[o] = static_cast<uint8_t>(m);
 }
 

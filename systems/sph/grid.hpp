@@ -154,6 +154,28 @@ struct CellRuns {
   uint8_t ready = 0;                  // bit o: runs[o] and count[o] are computed
   bool subcells = false;
 };
+// Sub-cell grids: the 27 sub-cells of edge h around octant o's sub-cell, x fastest, each as the
+// neighbouring cell it lies in (index into CellRuns::parent) and its octant there. The sub-cell
+// coordinates relative to the parent block's lowest sub-cell are s = 2 + bit per axis, the
+// neighbours s − 1 … s + 1 (in [1, 4]): cell u >> 1, octant bit u & 1.
+struct SubcellStep {
+  uint8_t parent, octant;
+};
+inline constexpr std::array<std::array<SubcellStep, 27>, 8> kSubcellSteps = [] {
+  std::array<std::array<SubcellStep, 27>, 8> t{};
+  for (int o = 0; o < 8; ++o) {
+    const int sx = 2 + (o & 1), sy = 2 + ((o >> 1) & 1), sz = 2 + ((o >> 2) & 1);
+    int k = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx, ++k) {
+          const int ux = sx + dx, uy = sy + dy, uz = sz + dz;
+          t[o][k] = {static_cast<uint8_t>(((uz >> 1) * 3 + (uy >> 1)) * 3 + (ux >> 1)),
+                     static_cast<uint8_t>((ux & 1) | (uy & 1) << 1 | (uz & 1) << 2)};
+        }
+  }
+  return t;
+}();
 void cell_neighbourhood(const Grid& grid, uint32_t cell, CellRuns& out);
 void octant_runs(const Grid& grid, int octant, CellRuns& out);
 // Both of the above for all eight octants.

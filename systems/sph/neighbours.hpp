@@ -28,12 +28,18 @@ class Candidates {
  public:
   explicit Candidates(const Grid& g) : g_(g) {}
 
-  // The runs of slot i (valid until the next call).
-  std::span<const Run> runs(uint32_t i) {
+  // The neighbourhood of slot i's cell (CellRuns::parent or block; valid until the next call).
+  const CellRuns& neighbourhood(uint32_t i) {
     if (g_.slot_cell[i] != cell_) {
       cell_ = g_.slot_cell[i];
       cell_neighbourhood(g_, cell_, cell_runs_);
     }
+    return cell_runs_;
+  }
+
+  // The runs of slot i (valid until the next call).
+  std::span<const Run> runs(uint32_t i) {
+    neighbourhood(i);
     const uint8_t o = g_.octant[i];
     if (!(cell_runs_.ready & (1u << o))) octant_runs(g_, o, cell_runs_);
     return {cell_runs_.runs[o].data(), cell_runs_.count[o]};
