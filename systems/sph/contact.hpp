@@ -56,9 +56,6 @@ struct ContactScratch {
   // Per grid cell: smallest and largest fragment in it; with sub-cells, then per sub-cell (8 a
   // cell, from index cells on).
   std::vector<uint32_t> cell_lo, cell_hi;
-  // Unused (the contact pass decides per cell whether its block holds two fragments): kept
-  // for now so that ContactScratch, inside FragmentLens, keeps its layout; to be removed.
-  std::vector<uint8_t> mixed;
   std::vector<uint32_t> fragment_slot;  // per slot (+ kPad): the fragment label
 };
 
