@@ -87,7 +87,7 @@ void run_nucleus(const StudyOptions& options) {
   t.columns = {"level",         "threads",      "cells",        "fragments_max", "sph_pairs_mean",
                "sph_pairs_max", "frame_p50_ms", "frame_p99_ms", "frame_max_ms",  "lens_mean_ms",
                "speedup",       "error_pct",    "score"};
-  Chart cost{.title = "Nucleus removal: frame time per level (expert, 93 s)",
+  Chart cost{.title = "Nucleus removal: frame time per level (expert)",
              .x = {.label = "lens cells", .scale = Scale::Log10},
              .y = {.label = "frame time (ms)", .scale = Scale::Log10}};
   Series p99_1{.name = "p99, 1 thread"}, p99_2{.name = "p99, 2 threads"},
@@ -95,8 +95,8 @@ void run_nucleus(const StudyOptions& options) {
   std::string md = "## Nucleus removal per level (issue 19)\n\n";
   md += "Measured by `phaco-perf nucleus" + std::string(options.quick ? " --quick" : "") + "`, " +
         load +
-        ". The scripted expert (`data/scenarios/nucleus_removal_expert.json`, 93 s: three cracks "
-        "with probe and chopper, then each quadrant held and emulsified) at each level, each "
+        ". The scripted expert (`data/scenarios/nucleus_removal_expert.json`: cracks with probe "
+        "and chopper, then each quadrant held and emulsified) at each level, each "
         "point a process with the 1 kHz haptic thread beside it. The lens is seed 002's simplex "
         "cells (one per tet of the level's lens). Error: the largest relative difference of the "
         "volume removed, the cracks and the chopper's largest push against the finest level "
