@@ -191,6 +191,18 @@ struct StepStatus {
   double wall_s = 0;         // from the step's start (its scene's build included)
 };
 
+// Why a haptic period ran long: the wake-up's lateness, the tick's own compute, the spin before
+// the deadline, and deadlines skipped (engine/haptics/loop_stats.hpp), in µs.
+nlohmann::json haptic_loop_json(const TrainerStatus& s) {
+  const auto summary = [](const DurationSummary& d) {
+    return nlohmann::json{{"p50_us", d.p50_us}, {"p99_us", d.p99_us}, {"max_us", d.max_us}};
+  };
+  const LoopStatsSnapshot& l = s.haptic_loop;
+  return {{"fifo", s.haptic_fifo},         {"overruns", l.overruns},
+          {"period", summary(l.period)},   {"lateness", summary(l.lateness)},
+          {"compute", summary(l.compute)}, {"spin", summary(l.spin)}};
+}
+
 nlohmann::json step_json(const StepStatus& st) {
   const TrainerStatus& s = st.status;
   return {{"drill", st.drill},
@@ -202,6 +214,7 @@ nlohmann::json step_json(const StepStatus& st) {
           {"haptic_period_p50_us", s.haptic_period_p50_us},
           {"haptic_period_p99_us", s.haptic_period_p99_us},
           {"haptic_ticks", s.haptic_ticks},
+          {"haptic_loop", haptic_loop_json(s)},
           {"snapshots_published", s.snapshots_published}};
 }
 
@@ -240,6 +253,7 @@ void write_stats(const std::filesystem::path& file, const TrainerOptions& o, con
   j["haptic_period_p50_us"] = s.haptic_period_p50_us;
   j["haptic_period_p99_us"] = s.haptic_period_p99_us;
   j["haptic_ticks"] = s.haptic_ticks;
+  if (steps.empty()) j["haptic_loop"] = haptic_loop_json(s);  // a procedure's: per step
   j["snapshots_published"] = s.snapshots_published;
   if (!steps.empty()) {
     j["steps"] = nlohmann::json::array();

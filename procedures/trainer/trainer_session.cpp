@@ -361,6 +361,8 @@ TrainerStatus TrainerSession::status() const {
     s.haptic_period_p50_us = h.loop.period.p50_us;
     s.haptic_period_p99_us = h.loop.period.p99_us;
     s.haptic_ticks = h.loop.ticks;
+    s.haptic_loop = h.loop;
+    s.haptic_fifo = h.realtime.fifo;
   }
   if (failed_.load(std::memory_order_acquire)) s.error = error_;
   return s;

@@ -30,6 +30,7 @@
 #include <thread>
 #include <vector>
 
+#include "engine/haptics/loop_stats.hpp"
 #include "engine/haptics/recording_device.hpp"
 #include "engine/haptics/spsc_ring.hpp"
 #include "engine/haptics/triple_buffer.hpp"
@@ -85,6 +86,10 @@ struct TrainerStatus {
   double step_p50_ms = 0;  // not kept live: see finish()'s "live" report
   double haptic_period_p50_us = 0, haptic_period_p99_us = 0;
   int64_t haptic_ticks = 0;
+  // Why a period ran long (--stats): the loop's full figures (engine/haptics/loop_stats.hpp):
+  // a late wake-up (lateness), a long tick (compute), a deadline skipped (overruns).
+  LoopStatsSnapshot haptic_loop;
+  bool haptic_fifo = false;  // SCHED_FIFO granted to the haptic thread
   uint64_t snapshots_published = 0;
   uint64_t events_dropped = 0;  // the event ring was full (the UI did not poll)
   std::string error;            // the simulation thread's exception, if it stopped on one
