@@ -22,13 +22,18 @@ sources() {
   git -C "$root" ls-files '*.cpp' '*.hpp' 2>/dev/null ||
     (cd "$root" && find apps components engine perf procedures systems tests -name '*.[ch]pp')
 }
-unformatted="$(cd "$root" && sources | while read -r f; do
-  clang-format --style=file "$f" | cmp -s - "$f" || echo "$f"; done)"
-if [ -n "$unformatted" ]; then
+# One clang-format process per 100 files (--dry-run -Werror reports each differing file by name):
+# a process per file spent ~1.5 CPU minutes loading clang-format 675 times, this ~4 s.
+format_log="$(mktemp)"
+if ! (cd "$root" && sources | xargs -r -n 100 -P "$jobs" clang-format --style=file --dry-run -Werror) \
+  >/dev/null 2>"$format_log"; then
+  unformatted="$(sed -n 's/^\(.*\):[0-9]*:[0-9]*: error: code should be clang-formatted.*/\1/p' \
+    "$format_log" | sort -u)"
   echo "test.sh: these files differ from .clang-format (run clang-format -i on them):" >&2
-  echo "$unformatted" >&2
+  if [ -n "$unformatted" ]; then echo "$unformatted" >&2; else cat "$format_log" >&2; fi
   exit 1
 fi
+rm -f "$format_log"
 
 build="$root/build/release"
 PHACO_BUILD_DIR="$build" "$root/scripts/build.sh" -DPHACO_UNITY_BUILD=ON

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <vector>
 
 #include "components/tool.hpp"
 #include "engine/io/track.hpp"
@@ -16,6 +17,7 @@
 #include "procedures/scene/scene.hpp"
 #include "systems/haptic_model/haptic_model.hpp"
 #include "tests/support/capture_port.hpp"
+#include "tests/support/sanitizers.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
@@ -104,8 +106,15 @@ void print(const char* what, const Feel& f) {
 // synthetic trench tests hold (test_sphere_contacts.cpp): while the probe cuts, each frame's
 // removal under the tip changes the material more than the 4 ms crossfade hides (measured 9.6 %
 // tets, 8.4 % fragments, ≈ 3–4 mN on a ≈ 15 mN cut; docs/haptic_model.md, "Limits").
+// Under ASan only the fragment lens (seed 002's cells, the nucleus drill's model): both models'
+// 12 s at level 3 took 255 s there on a loaded machine, the fragment lens alone 70 s. The tet
+// lens's haptic spheres run under ASan in
+// HapticPublish.TheSculptedLensComesAsSpheresOfItsMaterialNearTheTip.
 TEST(HapticLensFeel, TheSculptingProbeFeelsTheNucleusContinuously) {
-  for (const char* model : {"tets", "fragments"}) {
+  const std::vector<const char*> models = test::kUnderAsan
+                                              ? std::vector<const char*>{"fragments"}
+                                              : std::vector<const char*>{"tets", "fragments"};
+  for (const char* model : models) {
     Scenario s = test::repo_scenario("phaco_sculpting_demo.json");
     s.methods["lens.model"] = model;
     haptic_model::HapticSettings settings;

@@ -20,6 +20,7 @@
 #include "procedures/scene/scene.hpp"
 #include "systems/haptic_model/haptic_model.hpp"
 #include "tests/support/capture_port.hpp"
+#include "tests/support/sanitizers.hpp"
 #include "tests/support/scene_run.hpp"
 
 namespace phaco {
@@ -403,7 +404,11 @@ TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsR
 // The nucleus_removal drill's own aspiration fills the probe's held-fragment record (no synthetic
 // record): while the expert holds a quadrant, the published model carries it with its mass, its
 // weight less buoyancy, Stokes drag and the vacuum's grip, each against its formula.
+// Release only: the expert first holds a quadrant after its cracks, over half its 110 s drill in,
+// which ASan at -O1 took 300 s to reach (CI's whole ASan pass is ~20 min). The same publishing
+// code runs under ASan in TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsRecord.
 TEST(HapticPublish, TheDrillsAspirationPublishesTheQuadrantItHolds) {
+  if (test::kUnderAsan) GTEST_SKIP() << "Release only: 300 s under ASan (see above)";
   CapturePort port;
   Scenario s = test::repo_scenario("nucleus_removal_expert.json");
   // At the scenario's own level (1). At level 0 the expert held nothing over its whole run (seen
