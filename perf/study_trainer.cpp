@@ -50,6 +50,18 @@ TrainerRun run_procedure(const fs::path& bin, const fs::path& dir, const fs::pat
                      "--stats-after " + after + " --timeout 3600", render);
 }
 
+// Why a haptic period ran long (the trainer's --stats `haptic_loop`): the wake-up's lateness and
+// the tick's own compute at p99, and the deadlines skipped.
+std::string loop_why(const nlohmann::json& stats) {
+  const nlohmann::json loop = stats.value("haptic_loop", nlohmann::json::object());
+  if (loop.empty()) return "—";
+  const auto p99 = [&](const char* part) {
+    return loop.value(part, nlohmann::json::object()).value("p99_us", 0.0);
+  };
+  return fmt("%.0f", p99("lateness")) + " / " + fmt("%.0f", p99("compute")) + ", " +
+         fmt("%.0f", loop.value("overruns", 0.0));
+}
+
 // The procedure's section: the whole run's figures, then each step's (render on).
 std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const fs::path& file,
                               bool quick) {
@@ -85,7 +97,8 @@ std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const
   }
   md +=
       "\n| step | fps (render on) | wall s | simulated s | simulation Hz | haptic period p50 / "
-      "p99 us, render on (off) |\n|---|---|---|---|---|---|\n";
+      "p99 us, render on (off) | lateness / compute p99 us, overruns |\n"
+      "|---|---|---|---|---|---|---|\n";
   const auto steps_a = a.value("steps", nlohmann::json::array());
   const auto steps_b = b.value("steps", nlohmann::json::array());
   for (size_t i = 0; i < steps_a.size(); ++i) {
@@ -99,7 +112,7 @@ std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const
     if (i < steps_b.size())
       md += " (" + fmt("%.0f", steps_b[i].value("haptic_period_p50_us", 0.0)) + " / " +
             fmt("%.0f", steps_b[i].value("haptic_period_p99_us", 0.0)) + ")";
-    md += " |\n";
+    md += " | " + loop_why(s) + " |\n";
   }
   return md + "\n";
 }
@@ -121,8 +134,8 @@ void run_trainer_study(const StudyOptions& options) {
   const fs::path dir = options.out_dir / "results";
   const fs::path bin = trainer_binary();
   const double seconds = options.quick ? 5 : 20;
-  const std::array<std::string, 3> drills = {"capsulorhexis", "phaco_sculpting",
-                                             "corneal_incision"};
+  const std::array<std::string, 4> drills = {"capsulorhexis", "phaco_sculpting", "corneal_incision",
+                                             "nucleus_removal"};
   Progress progress(static_cast<int>(drills.size()) * 2 + 3);
   std::vector<TrainerRun> runs;
   for (const auto& d : drills) {
@@ -154,19 +167,24 @@ void run_trainer_study(const StudyOptions& options) {
                "snapshots_published",
                "wall_s"};
   std::string md = "## The trainer: frame rate on the software renderer (issue 8)\n\n";
-  md += std::string("Measured by `phaco-perf trainer") + (options.quick ? " --quick" : "") + "`, " +
-        load + ". `phaco-trainer` under Xvfb at " + std::to_string(kTrainerWidth) + "×" +
-        std::to_string(kTrainerHeight) +
-        ", the default eye (level 3), both hands on scripted devices " +
-        "through the 1 kHz loop, " + fmt("%.0f", seconds) +
-        " s per run; *render off* is the same process and loop drawing nothing. The simulation's "
-        "target rate is 1/dt = 120 Hz, the haptic period 1000 us; the render target is 30 fps.\n\n";
+  md +=
+      std::string("Measured by `phaco-perf trainer") + (options.quick ? " --quick" : "") + "`, " +
+      load + ". `phaco-trainer` under Xvfb at " + std::to_string(kTrainerWidth) + "×" +
+      std::to_string(kTrainerHeight) +
+      ", the default eye (level 3), both hands on scripted devices " + "through the 1 kHz loop, " +
+      fmt("%.0f", seconds) +
+      " s per run; *render off* is the same process and loop drawing nothing. The simulation's "
+      "target rate is 1/dt = 120 Hz, the haptic period 1000 us; the render target is 30 fps. "
+      "A haptic period runs long when the thread wakes late (lateness: wake-up after the deadline) "
+      "or a tick's own work (compute: the device, the local haptic model, the force) outlasts "
+      "the period (overruns: deadlines skipped).\n\n";
   md +=
       "| drill | renderer | fps | frame p50 / p99 ms | target 30 fps | simulation Hz (render off) "
       "| "
-      "haptic period p50 / p99 us (render off) |\n|---|---|---|---|---|---|---|\n";
+      "haptic period p50 / p99 us (render off) | lateness / compute p99 us, overruns |\n"
+      "|---|---|---|---|---|---|---|---|\n";
   Chart chart{.title = "phaco-trainer on llvmpipe at 1280x720",
-              .x = {.label = "drill (1 rhexis, 2 sculpting, 3 incision)"},
+              .x = {.label = "drill (1 rhexis, 2 sculpting, 3 incision, 4 nucleus)"},
               .y = {.label = "rate (Hz)", .scale = Scale::Log10}};
   Series fps{.name = "render fps", .style = Style::LineAndMarkers},
       sim{.name = "simulation Hz, rendering", .style = Style::LineAndMarkers},
@@ -183,7 +201,7 @@ void run_trainer_study(const StudyOptions& options) {
           fmt("%.0f", on.value("haptic_period_p50_us", 0.0)) + " / " +
           fmt("%.0f", on.value("haptic_period_p99_us", 0.0)) + " (" +
           fmt("%.0f", off.value("haptic_period_p50_us", 0.0)) + " / " +
-          fmt("%.0f", off.value("haptic_period_p99_us", 0.0)) + ") |\n";
+          fmt("%.0f", off.value("haptic_period_p99_us", 0.0)) + ") | " + loop_why(on) + " |\n";
     const double x = static_cast<double>(i / 2 + 1);
     fps.x.push_back(x), fps.y.push_back(f);
     sim.x.push_back(x), sim.y.push_back(on.value("sim_rate_hz", 0.0));
