@@ -110,17 +110,10 @@ void mark_boundary(FragmentLens& l) {
   for (const auto& o : overlaps) each_bin(o.second, [&](uint32_t b) { ++first[b + 1]; });
   for (uint32_t b = 0; b < bins; ++b) first[b + 1] += first[b];
   items.resize(first[bins]);
-  // Each item's fragment beside it: a cell passes over the other fragments' regions of its bin
-  // (most of them: a quadrant's box meets a hundred crumbs') reading 4 bytes each, not the region.
-  auto& item_fragment = l.region_bin_fragment;
-  item_fragment.resize(first[bins]);
   std::vector<uint32_t>& fill = l.region_bin_fill;
   fill.assign(first.begin(), first.end() - 1);
   for (uint32_t k = 0; k < overlaps.size(); ++k)
-    each_bin(overlaps[k].second, [&](uint32_t b) {
-      item_fragment[fill[b]] = overlaps[k].first;
-      items[fill[b]++] = k;
-    });
+    each_bin(overlaps[k].second, [&](uint32_t b) { items[fill[b]++] = k; });
   parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
     for (uint32_t c = b; c < e; ++c) {
       if (!l.boundary[c] || !l.cells.alive[c]) {
@@ -132,10 +125,9 @@ void mark_boundary(FragmentLens& l) {
       uint8_t in = 0;
       const uint32_t cell_bin = (bin(2, p[2]) * dims[1] + bin(1, p[1])) * dims[0] + bin(0, p[0]);
       for (uint32_t i = first[cell_bin]; i < first[cell_bin + 1] && !in; ++i) {
-        if (item_fragment[i] != f) continue;
-        const auto& r = overlaps[items[i]].second;
-        in = p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] && p[2] >= r[2] &&
-             p[2] <= r[5];
+        const auto& [g, r] = overlaps[items[i]];
+        in = g == f && p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] &&
+             p[2] >= r[2] && p[2] <= r[5];
       }
       l.boundary[c] = in;
     }

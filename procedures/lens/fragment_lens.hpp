@@ -114,7 +114,6 @@ struct FragmentLens {
   std::vector<std::array<float, 6>> fragment_box;  // contact regions (fragment_lens.cpp)
   std::vector<uint32_t> fragment_order;
   std::vector<uint32_t> region_bin_first, region_bin_items, region_bin_fill;  // regions by bin
-  std::vector<uint32_t> region_bin_fragment;  // per item of region_bin_items: its region's fragment
   std::vector<std::pair<uint32_t, std::array<float, 6>>> overlaps;
   std::vector<uint8_t> pushed;  // per cell: fragment contact moved it this step
   std::vector<uint32_t> fragment_of;
