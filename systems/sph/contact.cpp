@@ -15,8 +15,7 @@ namespace phaco::sph {
 namespace {
 
 constexpr uint32_t kContactGrain = 256;
-constexpr uint32_t kCellGrain = 1024;    // grid cells per chunk of the fragment-range pass
-constexpr uint32_t kGatherGrain = 8192;  // particles per chunk of the boundary gather
+constexpr uint32_t kCellGrain = 1024;  // grid cells per chunk of the fragment-range pass
 
 // ∫ u(1 − u²)² du = −(1 − u²)³/6, normalised by the peak u_p(1 − u_p²)², u_p = 1/√5; below
 // u_p the shape is 1.
@@ -224,28 +223,9 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
   // Every column per particle, the forces too (a short one would be read or written past its end).
   assert(same_size(in.x, in.y, in.z, in.vx, in.vy, in.vz, in.fragment, in.boundary, fx, fy, fz));
   const auto n = static_cast<uint32_t>(in.x.size());
-  // The boundary particles in id order, over fixed chunks side by side: counts, their starts,
-  // then each chunk writes its own (the serial gather over every cell was 2 % of the lens step).
-  const uint32_t chunks = (n + kGatherGrain - 1) / kGatherGrain;
-  auto& start = scratch.chunk_members;
-  start.assign(size_t{chunks} + 1, 0);
-  parallel_for(0, chunks, 1, [&](uint32_t cb, uint32_t ce, int) {
-    for (uint32_t ch = cb; ch < ce; ++ch) {
-      uint32_t count = 0;
-      for (uint32_t i = ch * kGatherGrain; i < std::min(n, (ch + 1) * kGatherGrain); ++i)
-        count += in.boundary[i] != 0;
-      start[ch + 1] = count;
-    }
-  });
-  for (uint32_t ch = 0; ch < chunks; ++ch) start[ch + 1] += start[ch];
-  scratch.members.resize(start[chunks]);
-  parallel_for(0, chunks, 1, [&](uint32_t cb, uint32_t ce, int) {
-    for (uint32_t ch = cb; ch < ce; ++ch) {
-      uint32_t* out = scratch.members.data() + start[ch];
-      for (uint32_t i = ch * kGatherGrain; i < std::min(n, (ch + 1) * kGatherGrain); ++i)
-        if (in.boundary[i]) *out++ = i;
-    }
-  });
+  scratch.members.clear();
+  for (uint32_t i = 0; i < n; ++i)
+    if (in.boundary[i]) scratch.members.push_back(i);
   stats.particles = static_cast<uint32_t>(scratch.members.size());
   if (stats.particles < 2) return stats;
   Grid& g = scratch.grid;

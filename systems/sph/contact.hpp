@@ -52,8 +52,7 @@ struct ContactParticles {
 
 struct ContactScratch {
   Grid grid;
-  std::vector<uint32_t> members;        // boundary particles
-  std::vector<uint32_t> chunk_members;  // per chunk of the gather: where its members start
+  std::vector<uint32_t> members;  // boundary particles
   // Per grid cell: smallest and largest fragment in it; with sub-cells, then per sub-cell (8 a
   // cell, from index cells on).
   std::vector<uint32_t> cell_lo, cell_hi;
