@@ -57,57 +57,27 @@ bool inside(const Grid& g, int64_t ix, int64_t iy, int64_t iz) {
 }
 
 // Stable LSD radix sort of (key, id) by key, 8 bits per pass, skipping passes whose digit is the
-// same for every key. Each pass over fixed chunks of kSortGrain keys, side by side: per-chunk digit
-// counts, then each chunk's start per digit (digit first, then chunk order: what one pass in key
-// order gives), then each chunk places its keys. A stable sort has one result, so any thread count
-// gives the same order.
-constexpr uint32_t kSortGrain = 4096;
-
+// same for every key.
 void radix_sort(Grid& g, uint32_t n) {
-  const uint32_t chunks = (n + kSortGrain - 1) / kSortGrain;
-  const uint64_t all_or = parallel_reduce_ordered(
-      0u, n, kSortGrain, uint64_t{0},
-      [&](uint32_t b, uint32_t e) {
-        uint64_t v = 0;
-        for (uint32_t i = b; i < e; ++i) v |= g.key[i];
-        return v;
-      },
-      [](uint64_t a, uint64_t b) { return a | b; });
+  uint64_t all_or = 0;
+  for (uint32_t i = 0; i < n; ++i) all_or |= g.key[i];
   const int bits = 64 - std::countl_zero(all_or);
-  g.histogram.resize(size_t{256} * chunks);
-  uint32_t* hist = g.histogram.data();
+  g.histogram.assign(256, 0);
   for (int shift = 0; shift < bits; shift += 8) {
-    parallel_for(0, chunks, 1, [&](uint32_t cb, uint32_t ce, int) {
-      for (uint32_t ch = cb; ch < ce; ++ch) {
-        uint32_t* h = hist + size_t{256} * ch;
-        std::fill(h, h + 256, 0u);
-        const uint32_t end = std::min(n, (ch + 1) * kSortGrain);
-        for (uint32_t i = ch * kSortGrain; i < end; ++i) ++h[(g.key[i] >> shift) & 0xff];
-      }
-    });
-    const uint32_t first_digit = (g.key[0] >> shift) & 0xff;
-    uint32_t same = 0;
-    for (uint32_t ch = 0; ch < chunks; ++ch) same += hist[size_t{256} * ch + first_digit];
-    if (same == n) continue;  // one digit: nothing moves
+    std::fill(g.histogram.begin(), g.histogram.end(), 0u);
+    for (uint32_t i = 0; i < n; ++i) ++g.histogram[(g.key[i] >> shift) & 0xff];
+    if (g.histogram[(g.key[0] >> shift) & 0xff] == n) continue;  // one digit: nothing moves
     uint32_t sum = 0;
-    for (uint32_t d = 0; d < 256; ++d)
-      for (uint32_t ch = 0; ch < chunks; ++ch) {
-        uint32_t& h = hist[size_t{256} * ch + d];
-        const uint32_t c = h;
-        h = sum;
-        sum += c;
-      }
-    parallel_for(0, chunks, 1, [&](uint32_t cb, uint32_t ce, int) {
-      for (uint32_t ch = cb; ch < ce; ++ch) {
-        uint32_t* h = hist + size_t{256} * ch;
-        const uint32_t end = std::min(n, (ch + 1) * kSortGrain);
-        for (uint32_t i = ch * kSortGrain; i < end; ++i) {
-          const uint32_t dst = h[(g.key[i] >> shift) & 0xff]++;
-          g.key_tmp[dst] = g.key[i];
-          g.id_tmp[dst] = g.id[i];
-        }
-      }
-    });
+    for (uint32_t& h : g.histogram) {
+      const uint32_t c = h;
+      h = sum;
+      sum += c;
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t dst = g.histogram[(g.key[i] >> shift) & 0xff]++;
+      g.key_tmp[dst] = g.key[i];
+      g.id_tmp[dst] = g.id[i];
+    }
     g.key.swap(g.key_tmp);
     g.id.swap(g.id_tmp);
   }
@@ -222,31 +192,16 @@ void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
   }
   auto particle = [&](uint32_t i) { return subset.empty() ? i : subset[i]; };
 
-  // Bounds (min/max are exact, so the order of the loop and of the chunks' merge does not
-  // matter). NaN never wins.
-  using Box = std::array<double, 6>;  // lo x, y, z, hi x, y, z
-  const Box box = parallel_reduce_ordered(
-      0u, n, 4096, Box{1e300, 1e300, 1e300, -1e300, -1e300, -1e300},
-      [&](uint32_t b, uint32_t e) {
-        Box r{1e300, 1e300, 1e300, -1e300, -1e300, -1e300};
-        for (uint32_t i = b; i < e; ++i) {
-          const uint32_t p = particle(i);
-          const double v[3] = {x[p], y[p], z[p]};
-          for (int a = 0; a < 3; ++a) {
-            if (v[a] < r[a]) r[a] = v[a];
-            if (v[a] > r[a + 3]) r[a + 3] = v[a];
-          }
-        }
-        return r;
-      },
-      [](Box a, const Box& b) {
-        for (int k = 0; k < 3; ++k) {
-          if (b[k] < a[k]) a[k] = b[k];
-          if (b[k + 3] > a[k + 3]) a[k + 3] = b[k + 3];
-        }
-        return a;
-      });
-  double lo[3] = {box[0], box[1], box[2]}, hi[3] = {box[3], box[4], box[5]};
+  // Bounds (min/max are exact, so the order of this loop does not matter). NaN never wins.
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t p = particle(i);
+    const double v[3] = {x[p], y[p], z[p]};
+    for (int a = 0; a < 3; ++a) {
+      if (v[a] < lo[a]) lo[a] = v[a];
+      if (v[a] > hi[a]) hi[a] = v[a];
+    }
+  }
   const double inv_cell = 1.0 / g.cell;
   for (int a = 0; a < 3; ++a) {
     if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0.0;  // every coordinate NaN
