@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "components/tool.hpp"
-#include "engine/schedule/parallel.hpp"
 #include "procedures/scene/lens_fragments.hpp"
 #include "procedures/scene/scene.hpp"
 
@@ -80,29 +79,17 @@ uint32_t sample_nucleus_removal(Scene& scene, NucleusRemovalRecord& r, double dt
   const lens::FragmentLens& l = lf->lens;
   const uint32_t nf = l.fragments.count;
   r.fx.assign(nf, 0.0), r.fy.assign(nf, 0.0), r.fz.assign(nf, 0.0);
-  const auto piece = [&](uint32_t f) {
-    return f != l.held_fragment && l.fragments.mass[f] >= kPieceMassFraction * l.initial_mass_kg;
-  };
-  // The pieces' centres only, each over its members (alive, ascending ids) on one thread: the
-  // pieces side by side in chunks of about 4096 cells (the quadrants are most of the lens), the
-  // same sums.
-  const uint32_t cells = std::max(1u, nf ? l.fragments.offsets[nf] : 0u);
-  const auto grain = std::max<uint32_t>(1, static_cast<uint32_t>(uint64_t{nf} * 4096 / cells));
-  parallel_for(0, nf, grain, [&](uint32_t b, uint32_t e, int) {
-    for (uint32_t f = b; f < e; ++f) {
-      if (!piece(f)) continue;
-      for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
-        const uint32_t c = l.fragments.members[k];
-        const double mc = l.cells.mass[c];
-        r.fx[f] += mc * l.cells.x[c], r.fy[f] += mc * l.cells.y[c], r.fz[f] += mc * l.cells.z[c];
-      }
-    }
-  });
   uint32_t out = 0;
   const auto& ant = r.bounds.anterior_capsule;
   for (uint32_t f = 0; f < nf; ++f) {
-    if (!piece(f)) continue;
     const double m = l.fragments.mass[f];
+    if (f == l.held_fragment || m < kPieceMassFraction * l.initial_mass_kg) continue;
+    // The pieces' centres only, over their members (alive, ascending ids).
+    for (uint32_t k = l.fragments.offsets[f]; k < l.fragments.offsets[f + 1]; ++k) {
+      const uint32_t c = l.fragments.members[k];
+      const double mc = l.cells.mass[c];
+      r.fx[f] += mc * l.cells.x[c], r.fy[f] += mc * l.cells.y[c], r.fz[f] += mc * l.cells.z[c];
+    }
     const Vec3 c(r.fx[f] / m, r.fy[f] / m, r.fz[f] / m);
     out += (c - ant.centre).norm() > ant.radius_mm;
   }
