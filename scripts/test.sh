@@ -13,7 +13,11 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 jobs="${PHACO_JOBS:-$(nproc)}"
+# Each phase's wall time, printed as it ends, so a run's log shows where the 45 minutes go.
+phase_start=$SECONDS
+phase() { echo "test.sh: $1 took $((SECONDS - phase_start)) s (${SECONDS} s in all)"; phase_start=$SECONDS; }
 "$root/scripts/install-deps.sh"
+phase "installing the dependencies"
 
 # Formatting (issue 22): every C++ file as the project's .clang-format (Debian's clang-format)
 # lays it out; any file that differs fails the run, named, before anything is built.
@@ -34,9 +38,11 @@ if ! (cd "$root" && sources | xargs -r -n 100 -P "$jobs" clang-format --style=fi
   exit 1
 fi
 rm -f "$format_log"
+phase "the format check"
 
 build="$root/build/release"
 PHACO_BUILD_DIR="$build" "$root/scripts/build.sh" -DPHACO_UNITY_BUILD=ON
+phase "the Release build"
 # The xAPI validator the records tests run (issue 21): Learning Locker's, from npm, at the
 # version tests/tools/xapi/package-lock.json pins, installed into the build tree.
 mkdir -p "$build/xapi-validator"
@@ -56,18 +62,22 @@ export PHACO_CACHE_DIR="$build/mesh-cache"
 # pass on a machine where the renderer and the trainer never ran (tests/support/environment.hpp).
 export PHACO_TEST_STRICT=1
 ctest --test-dir "$build" --output-on-failure -j "$jobs"
+phase "the xAPI validator, PostgreSQL and the Release tests"
 # The perf harness's quick sweep (issue 9): every drill at levels 0..3 and each method alternative,
 # each point in its own process. It fails the run if a point does not run to its end, if 1 and 2
 # threads give different state hashes, or if the default methods diverge or leave their accuracy
 # bounds. Speed is reported (in build/release/perf-quick/RESULTS.md), never checked here.
 "$build/perf/phaco-perf" sweep --quick --out-dir "$build/perf-quick"
+phase "the quick sweep"
 # The trainer left running drill after drill for 90 s under Xvfb (issue 18): fails the run if its
 # memory grows more than 5 % after the first round of drills or a drill leaks GL objects.
 "$build/perf/phaco-perf" soak --quick --out-dir "$build/perf-quick"
+phase "the quick soak"
 # The Debian package (issue 23), made from this build tree, then checked as a trainee's PC gets it:
 # lintian, the desktop entry, and the unpacked programs run from an empty folder, finding their
 # data in the package and never opening the source tree (scripts/check-package.sh).
 "$root/scripts/check-package.sh" "$(PHACO_BUILD_DIR="$build" "$root/scripts/package.sh")"
+phase "the package and its check"
 
 if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   asan="$root/build/asan"
@@ -78,7 +88,9 @@ if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
     -DPHACO_BUILD_BENCHMARKS=OFF -DPHACO_UNITY_BUILD=ON >/dev/null
   # Only what the tests run (every test executable and the phaco CLI), not the perf harness.
   cmake --build "$asan" -j "$jobs" --target phaco_tests
+  phase "the ASan build"
   PHACO_CACHE_DIR="$asan/mesh-cache" ctest --test-dir "$asan" --output-on-failure -j "$jobs"
+  phase "the ASan tests"
 fi
 
 if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
@@ -93,4 +105,5 @@ if [ "${PHACO_SKIP_SANITIZERS:-0}" != "1" ]; then
   for t in "${haptic_tests[@]}"; do
     TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" "$tsan/tests/$t"
   done
+  phase "the TSan build and tests"
 fi

@@ -9,6 +9,7 @@
 
 #include "procedures/reference/flat_disc.hpp"
 #include "procedures/reference/membrane_disc.hpp"
+#include "tests/support/sanitizers.hpp"
 
 namespace phaco::reference {
 namespace {
@@ -63,10 +64,16 @@ MembraneProfileRow run(int level, DiscLayout layout, Pretension pretension,
   return r;
 }
 
+// The accuracy studies below solve discs of up to 8k vertices to equilibrium: 24–37 s each under
+// ASan (5–6 s in Release). What they check is accuracy, which is Release's to check; the same
+// solve runs under ASan in CurvilinearPrestretchIsAnisotropicAndMisses and LoadIsInTheLinearRange.
+constexpr const char* kAccuracyOnlyInRelease = "Release only: an accuracy study (see above)";
+
 // The engine's pre-stretch on the near-equilateral layout at the default level (8k vertices):
 // within 2 % (measured 1.79 % linear, 1.52 % quadratic; the error sits at the core edge and comes
 // from the pre-stress not being uniform, see the next tests).
 TEST(AnalyticMembrane, DefaultLevelIsotropicWithinTwoPercent) {
+  if (test::kUnderAsan) GTEST_SKIP() << kAccuracyOnlyInRelease;
   for (SpringLaw law : {SpringLaw::Linear, SpringLaw::Quadratic}) {
     const MembraneProfileRow r = run(3, DiscLayout::Isotropic, Pretension::UniformPrestretch, law);
     EXPECT_GT(r.vertices, 7000u);
@@ -79,6 +86,7 @@ TEST(AnalyticMembrane, DefaultLevelIsotropicWithinTwoPercent) {
 // every layout within 0.5 % (measured at level 3: 0.27 %, 0.11 %, 0.22 %; levels 2/3/2 here to
 // keep the test short).
 TEST(AnalyticMembrane, CotangentPretensionIsAccurateOnEveryLayout) {
+  if (test::kUnderAsan) GTEST_SKIP() << kAccuracyOnlyInRelease;
   for (DiscLayout layout :
        {DiscLayout::Curvilinear, DiscLayout::Isotropic, DiscLayout::Irregular}) {
     const MembraneProfileRow r =
@@ -102,6 +110,7 @@ TEST(AnalyticMembrane, CurvilinearPrestretchIsAnisotropicAndMisses) {
 // membrane. (The engine's uniform pre-stretch stalls at a 1.3 % floor instead: the stress error
 // does not shrink with h.)
 TEST(AnalyticMembrane, ErrorFallsWithResolutionAtSecondOrder) {
+  if (test::kUnderAsan) GTEST_SKIP() << kAccuracyOnlyInRelease;
   std::vector<double> h, err;
   for (int level = 0; level <= 3; ++level) {
     const MembraneProfileRow r =
