@@ -74,13 +74,16 @@ std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const
       "level; both hands on scripted devices) under the same Xvfb, " +
       (quick ? std::string("the first ") + fmt("%.0f", a.value("wall_s", 0.0)) + " s (--quick)"
              : std::string("from its start to its end")) +
-      "; the haptic loop and the frame count restart with each step, so the "
-      "procedure's haptic period is its worst step's and its simulation rate the "
-      "steps' frames over the whole wall time (step changes included). Targets: "
-      "30 fps, haptic period p99 ≤ 1020 us.\n\n";
+      "; the haptic loop and the frame count restart with each step (the next step's loop "
+      "starting from the spin margin the last one learned). The procedure's haptic period "
+      "p50 / p99 is pooled over every tick of every step (the steps' histograms merged: the "
+      "target's \"p99 over the procedure\"); the worst step's own p99 is beside it. The "
+      "simulation rate is the steps' frames over the whole wall time (step changes included). "
+      "Targets: 30 fps, haptic period p99 ≤ 1020 us.\n\n";
   md +=
       "| run | fps | frame p50 / p99 ms | target 30 fps | simulation Hz | haptic period p50 / "
-      "p99 us | target p99 ≤ 1020 us | wall s |\n|---|---|---|---|---|---|---|---|\n";
+      "p99 us, pooled | target p99 ≤ 1020 us | worst step's p99 us | wall s |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
   for (const TrainerRun* r : {&on, &off}) {
     const auto& s = r->stats;
     const double f = s.value("fps", 0.0);
@@ -93,7 +96,9 @@ std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const
           " | " + (r->render ? trainer_met(f >= kTargetFps) : std::string("—")) + " | " +
           fmt("%.1f", s.value("sim_rate_hz", 0.0)) + " | " +
           fmt("%.0f", s.value("haptic_period_p50_us", 0.0)) + " / " + fmt("%.0f", p99) + " | " +
-          trainer_met(p99 <= 1020.0) + " | " + fmt("%.0f", s.value("wall_s", 0.0)) + " |\n";
+          trainer_met(p99 <= 1020.0) + " | " +
+          fmt("%.1f", s.value("haptic_period_worst_step_p99_us", 0.0)) + " | " +
+          fmt("%.0f", s.value("wall_s", 0.0)) + " |\n";
   }
   md +=
       "\n| step | fps (render on) | wall s | simulated s | simulation Hz | haptic period p50 / "
@@ -119,11 +124,13 @@ std::string procedure_section(const TrainerRun& on, const TrainerRun& off, const
 
 void add_row(Table& t, const TrainerRun& r) {
   const auto& s = r.stats;
-  t.add({r.drill, r.render ? "on" : "off", s.value("renderer", std::string("?")),
-         s.value("fps", 0.0), s.value("frame_p50_ms", 0.0), s.value("frame_p99_ms", 0.0),
-         s.value("sim_rate_hz", 0.0), s.value("haptic_period_p50_us", 0.0),
-         s.value("haptic_period_p99_us", 0.0), s.value("haptic_ticks", 0.0),
-         s.value("snapshots_published", 0.0), s.value("wall_s", 0.0)});
+  t.add(
+      {r.drill, r.render ? "on" : "off", s.value("renderer", std::string("?")), s.value("fps", 0.0),
+       s.value("frame_p50_ms", 0.0), s.value("frame_p99_ms", 0.0), s.value("sim_rate_hz", 0.0),
+       s.value("haptic_period_p50_us", 0.0), s.value("haptic_period_p99_us", 0.0),
+       // A drill is its own only step.
+       s.value("haptic_period_worst_step_p99_us", s.value("haptic_period_p99_us", 0.0)),
+       s.value("haptic_ticks", 0.0), s.value("snapshots_published", 0.0), s.value("wall_s", 0.0)});
 }
 
 }  // namespace
@@ -154,17 +161,12 @@ void run_trainer_study(const StudyOptions& options) {
   progress.step("trainer: writing");
 
   Table t;
-  t.columns = {"drill",
-               "render",
-               "renderer",
-               "fps",
-               "frame_p50_ms",
-               "frame_p99_ms",
-               "sim_rate_hz",
-               "haptic_p50_us",
-               "haptic_p99_us",
-               "haptic_ticks",
-               "snapshots_published",
+  t.columns = {"drill",         "render",
+               "renderer",      "fps",
+               "frame_p50_ms",  "frame_p99_ms",
+               "sim_rate_hz",   "haptic_p50_us",
+               "haptic_p99_us", "haptic_worst_step_p99_us",
+               "haptic_ticks",  "snapshots_published",
                "wall_s"};
   std::string md = "## The trainer: frame rate on the software renderer (issue 8)\n\n";
   md +=

@@ -29,6 +29,7 @@
 #include "apps/trainer/trainer_ui.hpp"
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
+#include "engine/haptics/loop_stats.hpp"
 #include "engine/records/background_sync.hpp"
 #include "engine/records/record_location.hpp"
 #include "engine/records/record_run.hpp"
@@ -189,13 +190,18 @@ struct StepStatus {
   TrainerStatus status;
   size_t render_frames = 0;  // drawn while the step ran
   double wall_s = 0;         // from the step's start (its scene's build included)
+  // The step's haptic period histogram whole (a copy), so --stats can pool every tick of the
+  // procedure (write_stats); shared, as StepStatus lists are copied.
+  std::shared_ptr<const DurationHistogram> haptic_period;
+  int64_t spin_margin_start_ns = 0;  // the margin the step's loop started from (0: the floor)
 };
 
 // Why a haptic period ran long: the wake-up's lateness, the tick's own compute, the spin before
 // the deadline, and deadlines skipped (engine/haptics/loop_stats.hpp), in µs.
 nlohmann::json haptic_loop_json(const TrainerStatus& s) {
   const auto summary = [](const DurationSummary& d) {
-    return nlohmann::json{{"p50_us", d.p50_us}, {"p99_us", d.p99_us}, {"max_us", d.max_us}};
+    return nlohmann::json{
+        {"count", d.count}, {"p50_us", d.p50_us}, {"p99_us", d.p99_us}, {"max_us", d.max_us}};
   };
   const LoopStatsSnapshot& l = s.haptic_loop;
   return {{"fifo", s.haptic_fifo},         {"overruns", l.overruns},
@@ -215,27 +221,38 @@ nlohmann::json step_json(const StepStatus& st) {
           {"haptic_period_p99_us", s.haptic_period_p99_us},
           {"haptic_ticks", s.haptic_ticks},
           {"haptic_loop", haptic_loop_json(s)},
+          // The loop's spin margin (docs/haptic_loop.md) as the step began and as it left it:
+          // the next step starts from the latter.
+          {"haptic_spin_margin_start_us", static_cast<double>(st.spin_margin_start_ns) * 1e-3},
+          {"haptic_spin_margin_end_us", static_cast<double>(s.haptic_spin_margin_ns) * 1e-3},
           {"snapshots_published", s.snapshots_published}};
 }
 
 // `steps`: a procedure's sessions so far, the one in progress last (empty for a drill). Over a
-// procedure the simulation's frames and haptic ticks are the steps' sums and the haptic period's
-// percentiles the worst step's (each step's own are under "steps").
+// procedure the simulation's frames and haptic ticks are the steps' sums, and the haptic period's
+// p50/p99/max are pooled over every tick of every step (the steps' histograms merged: issue 20's
+// "p99 over the procedure"); the worst step's p99 is written beside it, and each step's own
+// figures are under "steps".
 void write_stats(const std::filesystem::path& file, const TrainerOptions& o, const FrameClock& fc,
                  const TrainerStatus& current, double wall_s,
                  const std::vector<StepStatus>& steps = {}) {
   TrainerStatus s = current;
+  DurationSummary pooled;
+  double worst_step_p99_us = 0;
   if (!steps.empty()) {
     s.frame = 0, s.sim_time_s = 0, s.haptic_ticks = 0, s.snapshots_published = 0;
-    s.haptic_period_p50_us = 0, s.haptic_period_p99_us = 0;
+    DurationHistogram all_ticks;
     for (const StepStatus& st : steps) {
       s.frame += st.status.frame;
       s.sim_time_s += st.status.sim_time_s;
       s.haptic_ticks += st.status.haptic_ticks;
       s.snapshots_published += st.status.snapshots_published;
-      s.haptic_period_p50_us = std::max(s.haptic_period_p50_us, st.status.haptic_period_p50_us);
-      s.haptic_period_p99_us = std::max(s.haptic_period_p99_us, st.status.haptic_period_p99_us);
+      if (st.haptic_period) all_ticks.merge(*st.haptic_period);
+      worst_step_p99_us = std::max(worst_step_p99_us, st.status.haptic_period_p99_us);
     }
+    pooled = all_ticks.summary();
+    s.haptic_period_p50_us = pooled.p50_us;
+    s.haptic_period_p99_us = pooled.p99_us;
   }
   nlohmann::json j;
   j["width"] = o.width;
@@ -254,6 +271,11 @@ void write_stats(const std::filesystem::path& file, const TrainerOptions& o, con
   j["haptic_period_p99_us"] = s.haptic_period_p99_us;
   j["haptic_ticks"] = s.haptic_ticks;
   if (steps.empty()) j["haptic_loop"] = haptic_loop_json(s);  // a procedure's: per step
+  if (!steps.empty()) {
+    j["haptic_period_max_us"] = pooled.max_us;
+    j["haptic_period_count"] = pooled.count;  // the periods pooled: the steps' counts summed
+    j["haptic_period_worst_step_p99_us"] = worst_step_p99_us;
+  }
   j["snapshots_published"] = s.snapshots_published;
   if (!steps.empty()) {
     j["steps"] = nlohmann::json::array();
@@ -471,8 +493,20 @@ int run_trainer(const TrainerOptions& o) {
     size_t step_frame0 = 0;
     double step_wall0 = 0;
     const auto this_step = [&] {
-      return StepStatus{std::string(to_string(config.scenario.drill)), session->status(),
-                        frames.ms.size() - step_frame0, wall_s() - step_wall0};
+      auto period = std::make_shared<DurationHistogram>();
+      session->merge_haptic_period_into(*period);
+      TrainerStatus status = session->status();
+      // The step's period figures from the very copy that is pooled (the loop may still be
+      // ticking): the steps' counts then add up to the pooled count exactly.
+      status.haptic_loop.period = period->summary();
+      status.haptic_period_p50_us = status.haptic_loop.period.p50_us;
+      status.haptic_period_p99_us = status.haptic_loop.period.p99_us;
+      return StepStatus{std::string(to_string(config.scenario.drill)),
+                        std::move(status),
+                        frames.ms.size() - step_frame0,
+                        wall_s() - step_wall0,
+                        std::move(period),
+                        session->config().haptics.loop.start_margin_ns};
     };
     const auto steps_so_far = [&] {
       std::vector<StepStatus> steps = procedure_steps;
@@ -498,6 +532,11 @@ int run_trainer(const TrainerOptions& o) {
         step_frame0 = frames.ms.size();
         step_wall0 = wall_s();
         config = procedure->step_config(config);
+        // The next step's haptic loop starts from the spin margin this one learned (set here, the
+        // one place a step's session follows another's): the machine, the renderer and the load
+        // it saw are the same, and a fresh loop at the 60 µs floor relearns a loaded machine
+        // only by waking late first (docs/haptic_loop.md, "A margin that follows the latency").
+        config.haptics.loop.start_margin_ns = procedure_steps.back().status.haptic_spin_margin_ns;
         restart_session(session, config);
         ui = TrainerUi(o, config);  // the next step's panels, its Result not yet shown
         ui.set_sync(sync.get());

@@ -94,6 +94,8 @@ void HapticLoop::start(TickFn tick, void* context, const LoopSettings& settings)
   if (settings.spin_ns < 0) throw std::invalid_argument("HapticLoop::start: spin_ns must be >= 0");
   if (settings.max_spin_ns < 0)
     throw std::invalid_argument("HapticLoop::start: max_spin_ns must be >= 0");
+  if (settings.start_margin_ns < 0)
+    throw std::invalid_argument("HapticLoop::start: start_margin_ns must be >= 0");
   if (settings.warmup_ticks < 0)
     throw std::invalid_argument("HapticLoop::start: warmup_ticks must be >= 0");
   if (settings.realtime && (settings.priority < 1 || settings.priority > 99))
@@ -189,6 +191,9 @@ void HapticLoop::run() {
   // spin_ns = 0 sleeps only, whatever max_spin_ns says; ≥ period spins only.
   SpinMargin margin{.floor_ns = settings_.spin_ns,
                     .cap_ns = settings_.spin_ns == 0 ? 0 : settings_.max_spin_ns};
+  if (settings_.start_margin_ns > 0) margin.start_at(settings_.start_margin_ns);
+  // Relaxed: a figure; start() returns after the release below, so it reads this one.
+  spin_margin_ns_.store(margin.margin_ns(), std::memory_order_relaxed);
   const int64_t warmup = settings_.warmup_ticks;
   // One period of margin before the first deadline, so tick 0 is not late by construction.
   start_ns_ = now_ns() + period;
@@ -227,6 +232,8 @@ void HapticLoop::run() {
                          end - wake, wake - spin_from);
       if (missed > 0) stats_.record_overrun(missed);
     }
+    // Relaxed: a figure for the owner (the next loop's start_margin_ns), no synchronisation.
+    spin_margin_ns_.store(margin.margin_ns(), std::memory_order_relaxed);
     previous_wake = wake;
     ++ticks_run;
     k += 1 + missed;  // the next deadline still in the future at wake-up

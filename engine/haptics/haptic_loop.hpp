@@ -35,8 +35,13 @@ struct LoopSettings {
       60'000;  // sleep to deadline − margin, then spin; 0 = sleep only, ≥ period = spin only
   int64_t max_spin_ns = 250'000;  // the margin grows with the observed wake-up latency up to
                                   // this (spin_margin.hpp); ≤ spin_ns: a fixed margin of spin_ns
-  bool realtime = true;           // ask for SCHED_FIFO
-  int priority = 80;              // SCHED_FIFO priority, 1–99
+  // The margin the first sleep uses, kept within [spin_ns, max_spin_ns]; 0: spin_ns. A loop that
+  // follows another on the same machine (the trainer's next procedure step: a new session, a new
+  // loop) starts from the previous loop's learned spin_margin_ns() instead of the floor, so it
+  // need not be late once to relearn a load that has not changed (docs/haptic_loop.md).
+  int64_t start_margin_ns = 0;
+  bool realtime = true;        // ask for SCHED_FIFO
+  int priority = 80;           // SCHED_FIFO priority, 1–99
   bool lock_memory = true;     // mlockall(MCL_CURRENT | MCL_FUTURE): no page faults on the hot path
   int cpu = -1;                // pin the thread to this CPU if ≥ 0
   int64_t warmup_ticks = 200;  // first ticks run but are not counted in the statistics
@@ -86,12 +91,20 @@ class HapticLoop {
   RealtimeStatus realtime_status() const { return status_; }
   int64_t start_ns() const { return start_ns_; }  // deadline of tick 0
   const LoopSettings& settings() const { return settings_; }
+  // The spin margin the loop's next sleep uses (spin_margin.hpp), what it has learned of the
+  // wake-up latency: settings().start_margin_ns (clamped) once start() returned, then updated
+  // every tick, and kept after stop(), so a following loop can start from it
+  // (LoopSettings::start_margin_ns). Thread: any (relaxed: a figure).
+  int64_t spin_margin_ns() const { return spin_margin_ns_.load(std::memory_order_relaxed); }
   // Any thread, also while running (approximate then; see loop_stats.hpp).
   LoopStatsSnapshot stats() const { return stats_.snapshot(); }
   // The period's histogram bins (charts of the period under load). Thread: any, as stats().
   std::vector<DurationHistogram::Bin> period_bins() const {
     return stats_.period().occupied_bins();
   }
+  // The period's histogram itself, to pool it with other loops' (DurationHistogram::merge).
+  // Thread: any, as stats(); valid while this loop lives.
+  const DurationHistogram& period_histogram() const { return stats_.period(); }
 
  private:
   void run();
@@ -105,6 +118,7 @@ class HapticLoop {
   LoopStats stats_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> ready_{false};
+  std::atomic<int64_t> spin_margin_ns_{0};
   std::thread thread_;
 };
 

@@ -97,6 +97,26 @@ DurationSummary DurationHistogram::summary() const {
   return s;
 }
 
+void DurationHistogram::merge(const DurationHistogram& other) {
+  // Relaxed throughout: the same single writer as record() (see the header).
+  const int64_t n_other = other.count_.load(std::memory_order_relaxed);
+  if (n_other == 0) return;
+  for (int64_t i = 0; i < kBins; ++i) {
+    const uint64_t add = other.bins_[i].load(std::memory_order_relaxed);
+    if (add > 0)
+      bins_[i].store(bins_[i].load(std::memory_order_relaxed) + add, std::memory_order_relaxed);
+  }
+  const int64_t n = count_.load(std::memory_order_relaxed);
+  const int64_t other_min = other.min_ns_.load(std::memory_order_relaxed);
+  const int64_t other_max = other.max_ns_.load(std::memory_order_relaxed);
+  if (n == 0 || other_min < min_ns_.load(std::memory_order_relaxed))
+    min_ns_.store(other_min, std::memory_order_relaxed);
+  if (n == 0 || other_max > max_ns_.load(std::memory_order_relaxed))
+    max_ns_.store(other_max, std::memory_order_relaxed);
+  bump(sum_ns_, other.sum_ns_.load(std::memory_order_relaxed));
+  count_.store(n + n_other, std::memory_order_relaxed);
+}
+
 std::vector<DurationHistogram::Bin> DurationHistogram::occupied_bins() const {
   std::vector<Bin> out;
   for (int64_t i = 0; i < kBins; ++i) {

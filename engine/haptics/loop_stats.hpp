@@ -60,6 +60,13 @@ class DurationHistogram {
   void reset();
   // Any thread.
   DurationSummary summary() const;
+  // Adds `other`'s samples to this one's (bins, count, sum, min, max), as if this histogram had
+  // recorded them too: the summary of a merge is the summary of one histogram fed both sample
+  // sets, exactly (tests/engine/haptics/test_loop_stats.cpp). For a figure pooled over several
+  // loops, e.g. the haptic period over a whole procedure's steps (apps/trainer). Thread: this
+  // histogram's recorder, or any thread while none runs (it writes as record() does); `other` may
+  // be recording meanwhile (its figures then approximate, as summary()'s are). Not with itself.
+  void merge(const DurationHistogram& other);
   // The occupied bins as (low edge µs, width µs, count), in order: for histogram charts.
   struct Bin {
     int64_t low_us = 0, width_us = 1;

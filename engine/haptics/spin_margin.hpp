@@ -44,6 +44,12 @@ struct SpinMargin {
   }
   // Once per tick, slept or not.
   void decay() { worst_ns *= decay_per_tick; }
+  // Starts from a margin learned before (LoopSettings::start_margin_ns, a previous loop's
+  // margin_ns()): the next margin_ns() is `margin` within [floor, cap], and it decays from there
+  // as a remembered overshoot would.
+  void start_at(int64_t margin) {
+    worst_ns = static_cast<double>(std::max<int64_t>(0, margin - guard_ns));
+  }
 };
 
 }  // namespace phaco

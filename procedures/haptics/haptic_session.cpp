@@ -204,6 +204,7 @@ HapticSessionStats HapticSession::stats() const {
   HapticSessionStats out;
   out.realtime = loop_.realtime_status();
   out.loop = loop_.stats();
+  out.spin_margin_ns = loop_.spin_margin_ns();
   out.models_published = published_.load(std::memory_order_relaxed);
   const int64_t now = now_ns();
   for (size_t k = 0; k < kHapticTools; ++k) {

@@ -66,6 +66,7 @@ struct HapticHandStats {
 struct HapticSessionStats {
   RealtimeStatus realtime;
   LoopStatsSnapshot loop;
+  int64_t spin_margin_ns = 0;  // the loop's learned spin margin (HapticLoop::spin_margin_ns)
   std::array<HapticHandStats, kHapticTools> hands;
   uint64_t models_published = 0;
 };
@@ -102,6 +103,8 @@ class HapticSession final : public HapticPort {
 
   // The 1 kHz thread's period histogram (occupied bins), for the harness's charts. Thread: any.
   std::vector<DurationHistogram::Bin> period_bins() const { return loop_.period_bins(); }
+  // The same histogram whole, to pool over sessions (the trainer's procedure steps). Thread: any.
+  const DurationHistogram& period_histogram() const { return loop_.period_histogram(); }
 
   // HapticPort. Thread: the simulation thread only (the ring's consumer, the triple buffer's
   // producer), concurrently with the 1 kHz thread.

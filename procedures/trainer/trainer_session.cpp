@@ -363,9 +363,14 @@ TrainerStatus TrainerSession::status() const {
     s.haptic_ticks = h.loop.ticks;
     s.haptic_loop = h.loop;
     s.haptic_fifo = h.realtime.fifo;
+    s.haptic_spin_margin_ns = h.spin_margin_ns;
   }
   if (failed_.load(std::memory_order_acquire)) s.error = error_;
   return s;
+}
+
+void TrainerSession::merge_haptic_period_into(DurationHistogram& into) const {
+  if (haptics_) into.merge(haptics_->period_histogram());
 }
 
 size_t TrainerSession::poll_events(std::vector<TrainerEvent>& out) {

@@ -90,6 +90,9 @@ struct TrainerStatus {
   // a late wake-up (lateness), a long tick (compute), a deadline skipped (overruns).
   LoopStatsSnapshot haptic_loop;
   bool haptic_fifo = false;  // SCHED_FIFO granted to the haptic thread
+  // The haptic loop's learned spin margin, ns: where the next procedure step's loop starts
+  // (LoopSettings::start_margin_ns, apps/trainer/trainer_app.cpp).
+  int64_t haptic_spin_margin_ns = 0;
   uint64_t snapshots_published = 0;
   uint64_t events_dropped = 0;  // the event ring was full (the UI did not poll)
   std::string error;            // the simulation thread's exception, if it stopped on one
@@ -137,6 +140,10 @@ class TrainerSession {
   const std::optional<Scenario>& last_recording() const { return last_recording_; }
   // The last finish()'s report.
   const nlohmann::json& last_report() const { return last_report_; }
+  // Adds the haptic loop's period histogram (every tick since the last start, warm-up excluded)
+  // to `into`: a procedure pools its steps' ticks (DurationHistogram::merge). Nothing before the
+  // first start. UI thread (the loop may be running: approximate then, as status()).
+  void merge_haptic_period_into(DurationHistogram& into) const;
 
   // Finished drills whose record could not be written (the database full, locked, read-only or
   // damaged: finish() then returns the report with "save_error" naming the database instead of

@@ -4,6 +4,7 @@
 // --stats covers every step.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -80,6 +81,32 @@ TEST(TrainerProcedure, StepsThroughAndItsRecordingReplays) {
   }
   EXPECT_EQ(stats["sim_frames"], frames);
   EXPECT_GT(stats["frames"].get<uint64_t>(), 0u) << "render frames";
+
+  // The haptic period over the procedure (issue 20's target): pooled over every tick of every
+  // step (the steps' histograms merged), with the worst step's p99 beside it. A mixture's
+  // quantile lies between its parts' (within half a bin: the figures are bin middles clamped to
+  // each one's own min/max), and the pooled periods are the steps' periods, each counted once.
+  double lo = 1e300, hi = 0;
+  int64_t periods = 0;
+  for (size_t i = 0; i < 2; ++i) {
+    const double p99 = stats["steps"][i].at("haptic_period_p99_us").get<double>();
+    lo = std::min(lo, p99), hi = std::max(hi, p99);
+    periods += stats["steps"][i].at("haptic_loop").at("period").at("count").get<int64_t>();
+  }
+  const double pooled = stats.at("haptic_period_p99_us").get<double>();
+  const double half_bin = 0.5 * std::max(1.0, hi / 64);  // 1 µs bins below 2048 µs, ≤ 1/64 above
+  EXPECT_GE(pooled, lo - half_bin) << stats.dump();
+  EXPECT_LE(pooled, hi + half_bin) << stats.dump();
+  EXPECT_EQ(stats.at("haptic_period_worst_step_p99_us").get<double>(), hi);
+  EXPECT_GT(periods, 0);
+  EXPECT_EQ(stats.at("haptic_period_count").get<int64_t>(), periods);
+  EXPECT_LE(stats.at("haptic_period_p50_us").get<double>(), pooled);
+  EXPECT_LE(pooled, stats.at("haptic_period_max_us").get<double>());
+  // The second step's loop started from the margin the first one left (LoopSettings::
+  // start_margin_ns), not from the floor.
+  EXPECT_EQ(stats["steps"][1].at("haptic_spin_margin_start_us"),
+            stats["steps"][0].at("haptic_spin_margin_end_us"));
+  EXPECT_EQ(stats["steps"][0].at("haptic_spin_margin_start_us").get<double>(), 0.0);
 }
 
 }  // namespace

@@ -160,12 +160,65 @@ TEST(SpinMargin, FollowsTheObservedWakeUpLatencyBetweenFloorAndCap) {
   ticks = 0;
   while (m.margin_ns() > 60'000 && ticks < 100'000) m.decay(), ++ticks;
   EXPECT_LT(ticks, 1'000);  // counted as the cap, not as 5 ms: back at the floor within a second
+  SpinMargin carried{.floor_ns = 60'000, .cap_ns = 250'000};
+  carried.start_at(170'000);  // a previous loop's margin
+  EXPECT_EQ(carried.margin_ns(), 170'000);
+  carried.decay();
+  EXPECT_LT(carried.margin_ns(), 170'000);  // and forgotten as an overshoot would be
+  EXPECT_GT(carried.margin_ns(), 160'000);
   SpinMargin fixed{.floor_ns = 60'000, .cap_ns = 60'000};
   fixed.observe_sleep(200'000);
   EXPECT_EQ(fixed.margin_ns(), 60'000);
   SpinMargin sleep_only{.floor_ns = 0, .cap_ns = 0};
   sleep_only.observe_sleep(200'000);
   EXPECT_EQ(sleep_only.margin_ns(), 0);
+}
+
+// The margin tick 0's sleep used, as the loop reports it from inside that tick.
+struct FirstMarginProbe {
+  const HapticLoop* loop = nullptr;
+  std::atomic<int64_t> first_margin_ns{-1};
+  std::atomic<int> count{0};
+  static void tick(void* self, const TickInfo&) {
+    auto* p = static_cast<FirstMarginProbe*>(self);
+    // Relaxed: the loop thread is the only writer; the test reads after stop() joined it.
+    if (p->count.load(std::memory_order_relaxed) == 0)
+      p->first_margin_ns.store(p->loop->spin_margin_ns(), std::memory_order_relaxed);
+    p->count.store(p->count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  }
+};
+
+int64_t first_margin_of(const LoopSettings& settings, int64_t* after_stop = nullptr) {
+  HapticLoop loop;
+  FirstMarginProbe p;
+  p.loop = &loop;
+  loop.start(&FirstMarginProbe::tick, &p, settings);
+  // Relaxed: a progress poll.
+  while (p.count.load(std::memory_order_relaxed) < 3)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  loop.stop();
+  if (after_stop) *after_stop = loop.spin_margin_ns();
+  return p.first_margin_ns.load();
+}
+
+// A loop started with a learned margin (the trainer's next procedure step, LoopSettings::
+// start_margin_ns) sleeps its first tick with it, not with the floor; the margin stays within
+// [spin_ns, max_spin_ns] and is still readable after stop() for the loop that follows.
+TEST(HapticLoop, StartedWithAMarginBeginsWithIt) {
+  LoopSettings s = quiet_settings();  // floor 60 µs, cap 250 µs
+  EXPECT_EQ(first_margin_of(s), 60'000);
+  s.start_margin_ns = 180'000;
+  int64_t kept = 0;
+  EXPECT_EQ(first_margin_of(s, &kept), 180'000);
+  EXPECT_GE(kept, 60'000);
+  EXPECT_LE(kept, 250'000);
+  s.start_margin_ns = 900'000;  // beyond the cap: the cap
+  EXPECT_EQ(first_margin_of(s), 250'000);
+  s.start_margin_ns = 10'000;  // below the floor: the floor
+  EXPECT_EQ(first_margin_of(s), 60'000);
+  s.start_margin_ns = -1;
+  HapticLoop loop;
+  EXPECT_THROW(loop.start(&FirstMarginProbe::tick, nullptr, s), std::invalid_argument);
 }
 
 TEST(HapticLoop, WithoutRealtimeReportsNotRequested) {

@@ -113,6 +113,63 @@ TEST(DurationHistogram, OccupiedBinsHoldEverySampleInOrder) {
   EXPECT_GT(bins[2].low_us + bins[2].width_us, 3000);
 }
 
+void expect_same_summary(const DurationSummary& got, const DurationSummary& want) {
+  EXPECT_EQ(got.count, want.count);
+  EXPECT_DOUBLE_EQ(got.mean_us, want.mean_us);
+  EXPECT_DOUBLE_EQ(got.min_us, want.min_us);
+  EXPECT_DOUBLE_EQ(got.p50_us, want.p50_us);
+  EXPECT_DOUBLE_EQ(got.p99_us, want.p99_us);
+  EXPECT_DOUBLE_EQ(got.p999_us, want.p999_us);
+  EXPECT_DOUBLE_EQ(got.max_us, want.max_us);
+}
+
+// The procedure's pooled haptic period (apps/trainer --stats): merging two loops' histograms
+// gives what one histogram fed both sample sets gives, and a mixture's p99 is neither part's.
+TEST(DurationHistogram, MergeEqualsOneHistogramFedBothSampleSets) {
+  std::mt19937_64 rng(20);
+  // A quiet step (1 ms ± a few µs, a rare long tick) and a loaded one (later wake-ups, a tail to
+  // 40 µs late, a core taken away for 6 ms): different shapes, so a wrong merge shows.
+  std::normal_distribution<double> quiet(1'000'000, 3'000), loaded(1'004'000, 9'000);
+  std::uniform_real_distribution<double> u(0, 1);
+  H a, b, both;
+  for (int i = 0; i < 20'000; ++i) {
+    const auto ns = static_cast<int64_t>(u(rng) < 0.003 ? 1'300'000 : quiet(rng));
+    a.record(ns), both.record(ns);
+  }
+  for (int i = 0; i < 7'000; ++i) {
+    const auto ns = static_cast<int64_t>(u(rng) < 0.02 ? 1'040'000 : loaded(rng));
+    b.record(ns), both.record(ns);
+  }
+  b.record(6'000'000), both.record(6'000'000);
+  b.record(-2'000), both.record(-2'000);  // a negative duration keeps its sign in min
+
+  H pooled;
+  pooled.merge(a);
+  pooled.merge(b);
+  expect_same_summary(pooled.summary(), both.summary());
+  // In the other order, into a histogram that already holds samples, and with an empty one (a
+  // step without ticks) between: the order does not matter.
+  H into_b;
+  into_b.merge(b);
+  into_b.merge(H{});
+  into_b.merge(a);
+  expect_same_summary(into_b.summary(), both.summary());
+  // Bin for bin, too.
+  const auto pb = pooled.occupied_bins(), bb = both.occupied_bins();
+  ASSERT_EQ(pb.size(), bb.size());
+  for (size_t i = 0; i < pb.size(); ++i) {
+    EXPECT_EQ(pb[i].low_us, bb[i].low_us) << i;
+    EXPECT_EQ(pb[i].count, bb[i].count) << i;
+  }
+  // A mixture's quantile lies between its parts' and here differs from both: the pooled p99 is
+  // not the worst part's p99 (the figure --stats wrote over a procedure before stop 36).
+  const double pa = a.summary().p99_us, pbq = b.summary().p99_us, pp = pooled.summary().p99_us;
+  EXPECT_GE(pp, std::min(pa, pbq));
+  EXPECT_LE(pp, std::max(pa, pbq));
+  EXPECT_NE(pp, std::max(pa, pbq));
+  EXPECT_EQ(pooled.summary().count, 27'002);
+}
+
 TEST(LoopStats, CountsTicksOverrunsAndMissedDeadlines) {
   LoopStats stats;
   stats.record_tick(-1, 20'000, 50'000);  // first tick: no period
