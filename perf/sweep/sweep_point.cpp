@@ -161,6 +161,12 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
     r.period_p99_us = h.loop.period.p99_us;
     r.period_p999_us = h.loop.period.p999_us;
     r.period_max_us = h.loop.period.max_us;
+    r.spin_mean_us = h.loop.spin.mean_us;
+    r.spin_p50_us = h.loop.spin.p50_us;
+    r.spin_p99_us = h.loop.spin.p99_us;
+    r.compute_mean_us = h.loop.compute.mean_us;
+    r.compute_p50_us = h.loop.compute.p50_us;
+    r.compute_p99_us = h.loop.compute.p99_us;
     r.haptic_allocations =
         countable && probe->marked() ? double(test::allocations_on_marked_threads()) : -1.0;
     for (const auto& b : session->period_bins())
@@ -247,6 +253,12 @@ nlohmann::json to_json(const SweepPointResult& r) {
           {"period_p99_us", r.period_p99_us},
           {"period_p999_us", r.period_p999_us},
           {"period_max_us", r.period_max_us},
+          {"spin_mean_us", r.spin_mean_us},
+          {"spin_p50_us", r.spin_p50_us},
+          {"spin_p99_us", r.spin_p99_us},
+          {"compute_mean_us", r.compute_mean_us},
+          {"compute_p50_us", r.compute_p50_us},
+          {"compute_p99_us", r.compute_p99_us},
           {"haptic_allocations", r.haptic_allocations},
           {"period_bins", r.period_bins},
           {"rss_before_mb", r.rss_before_mb},
@@ -282,6 +294,13 @@ SweepPointResult result_from_json(const nlohmann::json& j) {
   r.period_p99_us = j.at("period_p99_us");
   r.period_p999_us = j.at("period_p999_us");
   r.period_max_us = j.at("period_max_us");
+  // Points saved before these were recorded have none.
+  r.spin_mean_us = j.value("spin_mean_us", 0.0);
+  r.spin_p50_us = j.value("spin_p50_us", 0.0);
+  r.spin_p99_us = j.value("spin_p99_us", 0.0);
+  r.compute_mean_us = j.value("compute_mean_us", 0.0);
+  r.compute_p50_us = j.value("compute_p50_us", 0.0);
+  r.compute_p99_us = j.value("compute_p99_us", 0.0);
   r.haptic_allocations = j.at("haptic_allocations");
   r.period_bins = j.at("period_bins").get<std::vector<std::array<double, 3>>>();
   r.rss_before_mb = j.at("rss_before_mb");

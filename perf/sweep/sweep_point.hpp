@@ -57,6 +57,10 @@ struct SweepPointResult {
   std::string haptic_detail;
   double haptic_ticks = 0, haptic_overruns = 0, haptic_missed = 0;
   double period_p50_us = 0, period_p99_us = 0, period_p999_us = 0, period_max_us = 0;
+  // The wait's spin before each deadline and the tick's own compute (its CPU share beside the
+  // frames: what the simulation threads lose to it), µs.
+  double spin_mean_us = 0, spin_p50_us = 0, spin_p99_us = 0;
+  double compute_mean_us = 0, compute_p50_us = 0, compute_p99_us = 0;
   double haptic_allocations = -1;                  // −1: not countable (sanitizer build)
   std::vector<std::array<double, 3>> period_bins;  // (low µs, width µs, count)
   // Memory (MiB, resident): before the scene, after building it, peak while stepping.

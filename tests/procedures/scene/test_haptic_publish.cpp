@@ -369,6 +369,35 @@ TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsR
     EXPECT_LE((centre - pose.pos).norm() - t.sphere_r[j],
               t.tip_radius_mm + haptic_publish_settings(*scene).lens.reach_mm + 1e-4);
   }
+  // None missed: the spheres are the nearest boundary cells within reach that a plain scan of
+  // every cell in double finds (the publisher's float pre-test only drops cells beyond reach).
+  {
+    const SimplexCells& cells = lf.lens.cells;
+    const double reach = t.tip_radius_mm + haptic_publish_settings(*scene).lens.reach_mm;
+    std::vector<std::pair<float, uint32_t>> want;
+    for (uint32_t c = 0; c < cells.size(); ++c) {
+      if (!cells.alive[c]) continue;
+      if (t.held.held && lf.lens.fragments.label[c] == t.held.fragment) continue;
+      bool outer = false;
+      for (uint32_t k = 0; k < 4; ++k) outer |= cells.neighbour[c][k] == kNoSimplex;
+      if (!outer) continue;
+      const double dx = cells.x[c] - pose.pos.x(), dy = cells.y[c] - pose.pos.y(),
+                   dz = cells.z[c] - pose.pos.z();
+      const double gap =
+          std::sqrt(dx * dx + dy * dy + dz * dz) -
+          std::cbrt(3.0 * std::max(0.0, static_cast<double>(cells.volume[c])) / (4.0 * M_PI));
+      if (gap <= reach) want.emplace_back(static_cast<float>(gap), c);
+    }
+    std::sort(want.begin(), want.end());
+    ASSERT_GT(want.size(), 0u);
+    ASSERT_EQ(t.sphere_count, std::min<size_t>(want.size(), kHapticMaxSpheres));
+    for (uint32_t j = 0; j < t.sphere_count; ++j) {
+      const uint32_t c = want[j].second;
+      EXPECT_EQ(t.sphere_x[j], cells.x[c]) << j;
+      EXPECT_EQ(t.sphere_y[j], cells.y[c]) << j;
+      EXPECT_EQ(t.sphere_z[j], cells.z[c]) << j;
+    }
+  }
 
   // The drill's aspiration holds fragment 0 at the probe (synthetic: set as its code would).
   HeldFragment held;
