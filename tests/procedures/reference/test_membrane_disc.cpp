@@ -65,7 +65,7 @@ MembraneProfileRow run(int level, DiscLayout layout, Pretension pretension,
 }
 
 // The accuracy studies below solve discs of up to 8k vertices to equilibrium: 24–37 s each under
-// ASan (5–6 s in Release). What they check is accuracy, which is Release's to check; the same
+// ASan (4–6 s in Release). What they check is accuracy, which is Release's to check; the same
 // solve runs under ASan in CurvilinearPrestretchIsAnisotropicAndMisses and LoadIsInTheLinearRange.
 constexpr const char* kAccuracyOnlyInRelease = "Release only: an accuracy study (see above)";
 
