@@ -40,10 +40,14 @@ LoopSettings quiet_settings() {
   return s;
 }
 
-void run_until(const Recorder& r, int ticks) {
+// Waits until a tick function's counter reaches `ticks`.
+void run_until(const std::atomic<int>& count, int ticks) {
   // Relaxed: a progress poll; correctness is checked after the join.
-  while (r.count.load(std::memory_order_relaxed) < ticks)
+  while (count.load(std::memory_order_relaxed) < ticks)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
+}
+void run_until(const Recorder& r, int ticks) {
+  run_until(r.count, ticks);
 }
 
 TEST(HapticLoop, AbsoluteDeadlinesIncreasingIndicesAndExactAccounting) {
@@ -193,9 +197,7 @@ int64_t first_margin_of(const LoopSettings& settings, int64_t* after_stop = null
   FirstMarginProbe p;
   p.loop = &loop;
   loop.start(&FirstMarginProbe::tick, &p, settings);
-  // Relaxed: a progress poll.
-  while (p.count.load(std::memory_order_relaxed) < 3)
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  run_until(p.count, 3);
   loop.stop();
   if (after_stop) *after_stop = loop.spin_margin_ns();
   return p.first_margin_ns.load();
