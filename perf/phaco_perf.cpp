@@ -89,9 +89,10 @@ studies:
       and peak while tearing, the opening. Writes results/tear_force.*. About 1 minute.
   trainer
       Issue 8, phaco-trainer under Xvfb on Mesa's software renderer at 1280x720, each drill with
-      scripted hands: render frame rate and frame times, simulation rate and haptic period, with
-      and without rendering; then issue 20's scripted expert procedure (phaco-trainer --procedure)
-      from start to end, with and without rendering. About 8 minutes (quick 2). Needs xvfb-run.
+      scripted hands: render frame rate and frame times, simulation rate and haptic period (and
+      why a period ran long: lateness, compute, overruns), with and without rendering; then
+      issue 20's scripted expert procedure (phaco-trainer --procedure) from start to end, with and
+      without rendering. About 9 minutes (quick 2). Needs xvfb-run.
   trainer-ab --against OLD_TRAINER [--against-data DIR] [--label TEXT] [--variant NAME[@DRILL]=DIR]...
              [--reps N] [--seconds S] [--drill NAME]...
       Issue 24, this build's phaco-trainer against an earlier build's (a binary built from an

@@ -253,14 +253,10 @@ struct BagLeash {
     const float dx = x - b.cx, dy = y - b.cy, dz = z - b.cz;
     return !b.present | (dx * dx + dy * dy + dz * dz <= b.r2);
   }
-  bool surely_inside(float x, float y, float z) const {
-    const bool open = (sure.open2 >= 0) & (x * x + y * y < sure.open2);
-    return (open | in_ball(sure.anterior, x, y, z)) & in_ball(sure.posterior, x, y, z) &
-           in_ball(sure.cornea, x, y, z);
-  }
-  void operator()(FragmentLens& l, uint32_t c) const {
-    if (surely_inside(l.cells.x[c], l.cells.y[c], l.cells.z[c])) return;
-    pull_back(l, c);
+  static bool surely_inside(const lens_tools::SurelyInside& s, float x, float y, float z) {
+    const bool open = (s.open2 >= 0) & (x * x + y * y < s.open2);
+    return (open | in_ball(s.anterior, x, y, z)) & in_ball(s.posterior, x, y, z) &
+           in_ball(s.cornea, x, y, z);
   }
   [[gnu::noinline]] void pull_back(FragmentLens& l, uint32_t c) const {
     const Vec3 p(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
@@ -297,13 +293,19 @@ void match_shapes(FragmentLens& l, FragmentLensStats& st, double dt_s,
                                             l.settings.match);
   const float inv_dt = static_cast<float>(1.0 / dt_s);
   parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
+    // The leash's float test on a copy of its balls made here, in registers: read through the
+    // leash, the compiler loaded all of them again for every cell, since the loop's float stores
+    // might have been to them. The same test, the same positions.
+    const bool leashed = leash.has_value();
+    const lens_tools::SurelyInside sure =
+        leashed ? leash->sure : lens_tools::SurelyInside(l.settings.bounds, 0);
     for (uint32_t c = b; c < e; ++c) {
       if (!l.cells.alive[c]) continue;
-      const Vec3f d = l.current[c] - Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
-      l.cells.x[c] = l.current[c].x(), l.cells.y[c] = l.current[c].y(),
-      l.cells.z[c] = l.current[c].z();
+      const Vec3f to = l.current[c];
+      const Vec3f d = to - Vec3f(l.cells.x[c], l.cells.y[c], l.cells.z[c]);
+      l.cells.x[c] = to.x(), l.cells.y[c] = to.y(), l.cells.z[c] = to.z();
       l.vx[c] += d.x() * inv_dt, l.vy[c] += d.y() * inv_dt, l.vz[c] += d.z() * inv_dt;
-      if (leash) (*leash)(l, c);
+      if (leashed && !BagLeash::surely_inside(sure, to.x(), to.y(), to.z())) leash->pull_back(l, c);
     }
   });
 }

@@ -65,6 +65,133 @@ void unite(uint32_t* parent, uint32_t a, uint32_t b) {
   }
 }
 
+// The seed's painting: `label` to every cell reached from `seed` over internal links whose mark
+// is still kNoSimplex (the seed's too).
+void paint_from(const SimplexCells& cells, uint32_t seed, uint32_t label, uint32_t* mark,
+                std::vector<uint32_t>& stack) {
+  mark[seed] = label;
+  stack.assign(1, seed);
+  while (!stack.empty()) {
+    const uint32_t c = stack.back();
+    stack.pop_back();
+    for (uint32_t k = 0; k < 4; ++k) {
+      const uint32_t nb = cells.neighbour[c][k];
+      if (nb != kNoSimplex && mark[nb] == kNoSimplex) {
+        mark[nb] = label;
+        stack.push_back(nb);
+      }
+    }
+  }
+}
+
+// Mass and rest centroid of `ids` (ascending), summed as fragment_mass sums them.
+void piece_mass(const SimplexCells& cells, const uint32_t* ids, uint32_t count, double out[4]) {
+  double m = 0, cx = 0, cy = 0, cz = 0;
+  for (uint32_t k = 0; k < count; ++k) {
+    const uint32_t c = ids[k];
+    const double mc = cells.mass[c];
+    m += mc, cx += mc * cells.rest_x[c], cy += mc * cells.rest_y[c], cz += mc * cells.rest_z[c];
+  }
+  out[0] = m;
+  out[1] = m > 0 ? cx / m : 0.0, out[2] = m > 0 ? cy / m : 0.0, out[3] = m > 0 ? cz / m : 0.0;
+}
+
+// update_fragments after removals of which some may have split their fragment (touched 2): the
+// alive members of those fragments are split into connected parts by a flood over internal links
+// (a member links to members of its own fragment only), the other touched fragments lose their
+// removed members and the untouched keep theirs (and their masses); then every piece is numbered
+// by its smallest cell and the table rebuilt. Pieces list members ascending and sum masses over
+// them in that order: bit-identical to label_fragments_union_find's table over every cell.
+void relabel_split_fragments(const SimplexCells& cells, Fragments& frags, FragmentScratch& s) {
+  std::vector<uint32_t>& listed = s.piece_members;  // members of the pieces not kept in place
+  s.pieces.clear();
+  listed.clear();
+  auto add_piece = [&](uint32_t source, uint32_t begin, uint32_t end) {
+    FragmentScratch::Piece p{0, source, begin, end, {}};
+    if (source != kNoSimplex) {
+      p.first = frags.members[begin];
+      p.mass = {frags.mass[source], frags.rest_cx[source], frags.rest_cy[source],
+                frags.rest_cz[source]};
+    } else {
+      p.first = listed[begin];
+      piece_mass(cells, listed.data() + begin, end - begin, p.mass.data());
+    }
+    s.pieces.push_back(p);
+  };
+  s.parent.resize(cells.size());
+  std::vector<uint32_t>& alive = s.chunk_roots;  // one fragment's alive members, ascending
+  std::vector<uint32_t>& part_start = s.old_to_new;
+  for (uint32_t f = 0; f < frags.count; ++f) {
+    const uint32_t begin = frags.offsets[f], end = frags.offsets[f + 1];
+    if (s.touched[f] == 0) {
+      add_piece(f, begin, end);
+      continue;
+    }
+    alive.clear();
+    for (uint32_t k = begin; k < end; ++k)
+      if (cells.alive[frags.members[k]]) alive.push_back(frags.members[k]);
+    if (alive.empty()) continue;  // emptied: dropped
+    uint32_t parts = 1;
+    if (s.touched[f] == 2) {
+      // Flood from each member not yet reached, in ascending order: part p's seed is its
+      // smallest cell, so the parts are in the order of their smallest cells.
+      for (const uint32_t c : alive) s.parent[c] = kNoSimplex;
+      parts = 0;
+      for (const uint32_t seed : alive) {
+        if (s.parent[seed] != kNoSimplex) continue;
+        paint_from(cells, seed, parts++, s.parent.data(), s.stack);
+      }
+    }
+    const auto base = static_cast<uint32_t>(listed.size());
+    listed.resize(base + alive.size());
+    if (parts == 1) {
+      std::copy(alive.begin(), alive.end(), listed.begin() + base);
+      add_piece(kNoSimplex, base, static_cast<uint32_t>(listed.size()));
+      continue;
+    }
+    // The parts' members ascending: counted, then placed in id order.
+    part_start.assign(size_t{parts} + 1, 0);
+    for (const uint32_t c : alive) ++part_start[s.parent[c] + 1];
+    for (uint32_t p = 0; p < parts; ++p) part_start[p + 1] += part_start[p];
+    for (uint32_t p = 0; p <= parts; ++p) part_start[p] += base;
+    for (uint32_t p = 0; p < parts; ++p) add_piece(kNoSimplex, part_start[p], part_start[p]);
+    const size_t piece0 = s.pieces.size() - parts;
+    for (const uint32_t c : alive) listed[s.pieces[piece0 + s.parent[c]].end++] = c;
+    for (uint32_t p = 0; p < parts; ++p) {
+      FragmentScratch::Piece& piece = s.pieces[piece0 + p];
+      piece.first = listed[piece.begin];
+      piece_mass(cells, listed.data() + piece.begin, piece.end - piece.begin, piece.mass.data());
+    }
+  }
+  // Numbered by smallest cell; the table rebuilt in that order.
+  std::sort(s.pieces.begin(), s.pieces.end(),
+            [](const FragmentScratch::Piece& a, const FragmentScratch::Piece& b) {
+              return a.first < b.first;
+            });
+  const auto count = static_cast<uint32_t>(s.pieces.size());
+  std::vector<uint32_t>& table = s.table_members;
+  table.clear();
+  s.table_offsets.assign(1, 0);
+  for (uint32_t i = 0; i < count; ++i) {
+    const FragmentScratch::Piece& p = s.pieces[i];
+    const uint32_t* ids = (p.source != kNoSimplex ? frags.members.data() : listed.data());
+    for (uint32_t k = p.begin; k < p.end; ++k) {
+      table.push_back(ids[k]);
+      frags.label[ids[k]] = i;
+    }
+    s.table_offsets.push_back(static_cast<uint32_t>(table.size()));
+  }
+  frags.members.swap(table);
+  frags.offsets.swap(s.table_offsets);
+  frags.count = count;
+  frags.mass.resize(count), frags.rest_cx.resize(count), frags.rest_cy.resize(count),
+      frags.rest_cz.resize(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    const auto& m = s.pieces[i].mass;
+    frags.mass[i] = m[0], frags.rest_cx[i] = m[1], frags.rest_cy[i] = m[2], frags.rest_cz[i] = m[3];
+  }
+}
+
 }  // namespace
 
 void label_fragments_painting(const SimplexCells& cells, Fragments& out, FragmentScratch& scratch) {
@@ -73,21 +200,7 @@ void label_fragments_painting(const SimplexCells& cells, Fragments& out, Fragmen
   uint32_t next = 0;
   for (uint32_t seed = 0; seed < n; ++seed) {
     if (!cells.alive[seed] || out.label[seed] != kNoSimplex) continue;
-    out.label[seed] = next;
-    scratch.stack.clear();
-    scratch.stack.push_back(seed);
-    while (!scratch.stack.empty()) {
-      const uint32_t c = scratch.stack.back();
-      scratch.stack.pop_back();
-      for (uint32_t k = 0; k < 4; ++k) {
-        const uint32_t nb = cells.neighbour[c][k];
-        if (nb != kNoSimplex && out.label[nb] == kNoSimplex) {
-          out.label[nb] = next;
-          scratch.stack.push_back(nb);
-        }
-      }
-    }
-    ++next;
+    paint_from(cells, seed, next++, out.label.data(), scratch.stack);
   }
   finish_from_labels(cells, out, next);
 }
@@ -190,18 +303,24 @@ FragmentUpdate update_fragments(const SimplexCells& cells, std::span<const Remov
   FragmentUpdate result;
   bool may_split = false;
   scratch.touched.assign(frags.count, 0);
+  bool unknown = false;  // a removed cell without a fragment: relabel every cell
   for (const Removal& r : removals) {
     if (!r.removed) continue;
     may_split |= r.may_split;
     if (r.cell < frags.label.size() && frags.label[r.cell] != kNoSimplex) {
-      scratch.touched[frags.label[r.cell]] = 1;
+      uint8_t& t = scratch.touched[frags.label[r.cell]];
+      t = std::max<uint8_t>(t, r.may_split ? 2 : 1);
       frags.label[r.cell] = kNoSimplex;
+    } else if (r.may_split) {
+      unknown = true;
     }
   }
   if (may_split) {
-    // The parallel labelling: the same table as painting's (the header says why), sooner on a
-    // large lens.
-    label_fragments_union_find(cells, frags, scratch);
+    if (unknown || frags.label.size() != cells.size()) {
+      label_fragments_union_find(cells, frags, scratch);  // the same table (the header says why)
+    } else {
+      relabel_split_fragments(cells, frags, scratch);
+    }
     result.relabelled = true;
     result.fragments = frags.count;
     return result;

@@ -55,7 +55,7 @@ struct ContactLaw {
 
 // Per grid cell (sorted orders): its smallest and largest fragment (cell_lo/cell_hi); with
 // sub-cells, also each sub-cell's (from index `cells` on, 8 per cell; empty: lo > hi), which
-// single_fragment_octant reads. Whether a cell's 3×3×3 block holds more than one fragment
+// other_fragment_runs reads. Whether a cell's 3×3×3 block holds more than one fragment
 // (cell_mixed) is decided in the contact pass from the neighbourhood it finds anyway for the
 // cell's particles (it was found twice for every mixed cell: here and there).
 void fragment_ranges(const Grid& g, std::span<const uint32_t> fragment, ContactScratch& s) {
@@ -100,21 +100,31 @@ bool cell_mixed(const Grid& g, const ContactScratch& s, uint32_t cell, const Cel
   return false;
 }
 
-// Sub-cell grids: whether the 27 sub-cells a particle of octant o of `cell` scans (all its
-// candidates) hold one fragment only, its own. Such a particle has no pair: its sums stay +0, so
-// skipping it leaves the same bits (as for a cell that is not mixed, one level finer). Decided
-// once per octant from the sub-cells' fragment ranges, instead of per particle over the
-// candidates.
-bool single_fragment_octant(const ContactScratch& s, uint32_t cells, uint32_t cell, int o,
-                            const CellRuns& near) {
-  const uint32_t f = s.cell_lo[cells + 8 * size_t{cell} + o];
+// Sub-cell grids, a particle of octant o of `cell` whose own sub-cell holds fragment f only (so
+// every particle of that sub-cell is of f): the runs of its 27 sub-cells without those holding f
+// only (the pair test rejects each of their slots: same fragment), merged where one follows the
+// previous as subcell_octant's. What is left holds every candidate the test could accept, in the
+// same order, so the sums have the same bits; none left: the particle has no pair (its sums stay
+// +0, as for a cell that is not mixed, one level finer). One walk decides both, from the
+// sub-cells' fragment ranges, once per octant instead of per particle over the candidates.
+uint8_t other_fragment_runs(const Grid& g, const ContactScratch& s, uint32_t cells, uint32_t f,
+                            int o, const CellRuns& near, Run* out) {
+  const uint32_t* sub = g.sub_begin.data();
+  const uint32_t* lo = s.cell_lo.data() + cells;
+  const uint32_t* hi = s.cell_hi.data() + cells;
+  int m = 0;
   for (const SubcellStep step : kSubcellSteps[o]) {
     const uint32_t p = near.parent[step.parent];
     if (p == kNoSlot) continue;
-    const size_t at = cells + 8 * size_t{p} + step.octant;
-    if (s.cell_lo[at] <= s.cell_hi[at] && (s.cell_lo[at] != f || s.cell_hi[at] != f)) return false;
+    const size_t at = 8 * size_t{p} + step.octant;
+    const Run r{sub[at], sub[at + 1]};
+    if (r.begin == r.end || (lo[at] == f && hi[at] == f)) continue;
+    if (m > 0 && out[m - 1].end == r.begin)
+      out[m - 1].end = r.end;
+    else
+      out[m++] = r;
   }
-  return true;
+  return static_cast<uint8_t>(m);
 }
 
 // The contact sums of slots [from, to) (one grid cell's; sorted orders). Eight candidates at a
@@ -140,25 +150,40 @@ contact_slots(const Grid& g, const ContactParticles& in, const ContactScratch& s
   const uint32_t* fragment_slot = scratch.fragment_slot.data();
   const bool sub = !g.sub_begin.empty();
   const auto cells = static_cast<uint32_t>(g.cell_key.size());
-  uint8_t decided = 0, single = 0;  // per octant of the cell (single_fragment_octant)
+  // Per octant of the cell (sub-cell grids): its runs, decided at its first particle; those of an
+  // octant whose own sub-cell holds one fragment only without that fragment's sub-cells
+  // (other_fragment_runs), the others all 27 (Candidates::runs).
+  std::array<std::array<Run, kMaxRuns>, 8> own_runs;
+  std::array<std::span<const Run>, 8> octant_runs{};
+  uint8_t decided = 0;
   uint64_t pairs = 0;
   for (uint32_t i = from; i < to; ++i) {
+    std::span<const Run> runs;
     if (sub) {
       const int o = g.octant[i];
       const auto bit = static_cast<uint8_t>(1u << o);
       if (!(decided & bit)) {
         decided |= bit;
-        if (single_fragment_octant(scratch, cells, g.slot_cell[i], o, candidates.neighbourhood(i)))
-          single |= bit;
+        const size_t own = cells + 8 * size_t{g.slot_cell[i]} + o;
+        if (scratch.cell_lo[own] == scratch.cell_hi[own]) {
+          octant_runs[o] = {own_runs[o].data(),
+                            other_fragment_runs(g, scratch, cells, scratch.cell_lo[own], o,
+                                                candidates.neighbourhood(i), own_runs[o].data())};
+        } else {
+          octant_runs[o] = candidates.runs(i);
+        }
       }
-      if (single & bit) continue;
+      runs = octant_runs[o];
+      if (runs.empty()) continue;
+    } else {
+      runs = candidates.runs(i);
     }
     const uint32_t pi = g.id[i];
     const float xs = g.x[i], ys = g.y[i], zs = g.z[i];
     const F8 xi = simd8::splat(xs), yi = simd8::splat(ys), zi = simd8::splat(zs);
     const I8 fi = simd8::splat(static_cast<int32_t>(fragment_slot[i]));
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    for (const Run run : candidates.runs(i)) {
+    for (const Run run : runs) {
       for (uint32_t j = run.begin; j < run.end; j += 8) {
         const F8 dx = xi - load8(X + j), dy = yi - load8(Y + j), dz = zi - load8(Z + j);
         const F8 r2 = dx * dx + dy * dy + dz * dz;

@@ -67,13 +67,16 @@ TEST(TrainerProcedure, StepsThroughAndItsRecordingReplays) {
     EXPECT_EQ(stats["steps"][i]["sim_frames"], live["steps"][i]["frames"]) << i;
     frames += stats["steps"][i]["sim_frames"].get<uint64_t>();
     // Why a haptic period ran long, per step: the loop's own figures, the period's as above.
+    // No speed is judged here: each part must be there, its summary's order p50 ≤ p99 ≤ max
+    // (a field written under the wrong name breaks it), and the overruns a count.
     const nlohmann::json& loop = stats["steps"][i].at("haptic_loop");
-    EXPECT_EQ(loop["period"]["p99_us"], stats["steps"][i]["haptic_period_p99_us"]) << i;
+    EXPECT_EQ(loop.at("period").at("p99_us"), stats["steps"][i]["haptic_period_p99_us"]) << i;
     for (const char* part : {"lateness", "compute", "spin"}) {
-      EXPECT_LE(loop[part]["p50_us"].get<double>(), loop[part]["p99_us"].get<double>()) << part;
-      EXPECT_LE(loop[part]["p99_us"].get<double>(), loop[part]["max_us"].get<double>()) << part;
+      const nlohmann::json& d = loop.at(part);
+      EXPECT_LE(d.at("p50_us").get<double>(), d.at("p99_us").get<double>()) << part;
+      EXPECT_LE(d.at("p99_us").get<double>(), d.at("max_us").get<double>()) << part;
     }
-    EXPECT_GE(loop["overruns"].get<int64_t>(), 0) << i;
+    EXPECT_TRUE(loop.at("overruns").is_number_integer()) << i;
   }
   EXPECT_EQ(stats["sim_frames"], frames);
   EXPECT_GT(stats["frames"].get<uint64_t>(), 0u) << "render frames";

@@ -56,6 +56,10 @@ bool run_sequence(const SimplexCells& initial, const std::vector<uint32_t>& orde
     EXPECT_EQ(paint.offsets, incremental.offsets) << "removal " << i;
     EXPECT_EQ(paint.mass, incremental.mass) << "removal " << i;
     EXPECT_EQ(paint.rest_cx, incremental.rest_cx) << "removal " << i;
+    EXPECT_EQ(paint.rest_cy, incremental.rest_cy) << "removal " << i;
+    EXPECT_EQ(paint.rest_cz, incremental.rest_cz) << "removal " << i;
+    EXPECT_EQ(paint.members, incremental.members) << "removal " << i;
+    EXPECT_EQ(paint.count, incremental.count) << "removal " << i;
     EXPECT_EQ(testing::brute_force_labels(cells), paint.label) << "removal " << i;
     counts.max_fragments = std::max(counts.max_fragments, paint.count);
     if (::testing::Test::HasFailure()) return false;
