@@ -340,6 +340,10 @@ bool add_capsule_cutting(Scene& scene) {
       rule == "flap_force" ? tear::TearRule::FlapForce : tear::TearRule::MostStressedSpring;
   cc.tear.threshold_mn = tear::tear_resistance_mn(scene.params.get("capsule.tear_energy_j_m2"),
                                                   scene.params.get("capsule.thickness_mm"));
+  // σ_u·h: what a ligament to the tear's own start holds per mm of width (systems/tear); kPa =
+  // mN/mm².
+  cc.tear.ligament_strength_mn_per_mm =
+      scene.params.get("capsule.ultimate_stress_kpa") * scene.params.get("capsule.thickness_mm");
   cc.rim = make_rim_tears(scene, cc.tear.threshold_mn);
   double edge = 0.0;
   uint32_t counted = 0;

@@ -117,6 +117,49 @@ uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const Tea
   return best;
 }
 
+Ligament own_ligament(const std::vector<Vec3>& trail, const Vec3& tip) {
+  Ligament l;
+  double along = 0.0;  // along the trail from the tip back to `prev`
+  Vec3 prev = tip;
+  for (size_t i = trail.size(); i-- > 0;) {
+    const Vec3 ab = trail[i] - prev;
+    const double len2 = ab.squaredNorm(), len = std::sqrt(len2);
+    const double t = len2 > 0 ? std::clamp((tip - prev).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const Vec3 q = prev + t * ab;
+    const double d = (tip - q).norm(), s = along + t * len;
+    if (s > 0.0 && s >= kLigamentCurl * d && (!l.found || d < l.width_mm)) l = {true, d, q};
+    along += len, prev = trail[i];
+  }
+  return l;
+}
+
+namespace {
+
+// Whether the flap's pull breaks the ligament to the path's own start (tear.hpp), and where the
+// tear then runs: through the ligament's nearest point and a little beyond (half its width and two
+// vertex snaps), so that the cut meets the earlier cut's lip rather than stopping short of it.
+bool ligament_breaks(const cut::CutMesh& m, const cut::CutPath& path, const TearState& state,
+                     const Vec3& tip_x, const Vec3& flap_force, const TearSettings& tear,
+                     const cut::CutSettings& cut, Vec3& target) {
+  if (!(tear.ligament_strength_mn_per_mm > 0.0)) return false;
+  const Vec3 n = vertex_normal(m, path.tip);
+  const double pull = (flap_force - flap_force.dot(n) * n).norm();
+  if (!(pull > 0.0)) return false;
+  const Ligament l = own_ligament(state.trail, tip_x);
+  // A sliver: within one tear step of the start (what the flap-force rule crosses in one step).
+  if (!l.found || l.width_mm > tear.max_step_mm) return false;
+  // The flap's tension at the tip is the tear's plateau at most: the pull beyond F_c drags the
+  // disc.
+  if (std::min(pull, tear.threshold_mn) < tear.ligament_strength_mn_per_mm * l.width_mm)
+    return false;
+  const Vec3 across = l.to - tip_x;
+  const Vec3 dir = across.norm() > 1e-12 ? Vec3(across.normalized()) : path.direction;
+  target = l.to + (0.5 * l.width_mm + 2.0 * cut.snap.vertex_snap_mm) * dir;
+  return true;
+}
+
+}  // namespace
+
 TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state,
                          const Vec3& flap_force, const TearSettings& tear,
                          const cut::CutSettings& cut, cut::EditLog& log) {
@@ -129,8 +172,17 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state,
   ++state.steps;
   const uint32_t tip = path.tip;
   const Vec3 x = cut::particle_position(m.particles, tip);
+  if (state.trail.empty()) {  // the path before the tear: from its first vertex to the tip
+    const uint32_t first = path.sources.empty() ? tip : path.sources.front();
+    state.trail.push_back(
+        cut::particle_position(m.particles, m.particles.slots.alive(first) ? first : tip));
+    state.trail.push_back(x);
+  }
   Vec3 target;
-  if (tear.rule == TearRule::FlapForce) {
+  if (ligament_breaks(m, path, state, x, flap_force, tear, cut, target)) {
+    r.ligament_broke = true;
+    r.advance_mm = (target - x).norm();
+  } else if (tear.rule == TearRule::FlapForce) {
     const Vec3 step = flap_force_step(x, vertex_normal(m, tip), path.direction, flap_force, tear);
     if (step.norm() == 0.0) return r;
     r.advance_mm = step.norm();
@@ -156,11 +208,14 @@ TearStepReport tear_step(cut::CutMesh& m, cut::CutPath& path, TearState& state,
     state.warning_armed = true;
   }
   r.segment = cut::cut_towards(m, path, target, cut, log);
+  if (r.ligament_broke && !r.segment.made) r.advance_mm = 0.0;  // no way through: nothing moved
   if (r.segment.made) {
     r.advanced = true;
     ++state.advances;
     const Vec3 now = cut::particle_position(m.particles, path.tip);
-    if ((now - state.front).norm() <= cut.snap.vertex_snap_mm || tear.rule != TearRule::FlapForce)
+    state.trail.push_back(now);
+    if ((now - state.front).norm() <= cut.snap.vertex_snap_mm || tear.rule != TearRule::FlapForce ||
+        r.ligament_broke)
       state.front = now;
     const double radius = std::hypot(now.x(), now.y());
     state.max_radius_mm = std::max(state.max_radius_mm, radius);

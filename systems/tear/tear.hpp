@@ -40,6 +40,27 @@
 // flap's force cannot ramp above the plateau. (In the scene the held flap also drags the disc,
 // which no advance relieves: procedures/scene/capsule_cutting folds it at F_c.)
 //
+// The tear's last step: the ligament to its own start (issue 17). A tear that has come round to
+// within w of its own earlier cut (the cystotome's slit) leaves the disc hanging by a ligament of
+// width w; pulled by the flap force F, the ligament breaks once its net section reaches the
+// capsule's ultimate stress: F ≥ σ_u·h·w (net-section rupture of a remaining ligament, the plastic
+// collapse limit of fracture mechanics; σ_u ≈ 0.7 MPa, DESIGN §6, from the eye file; seed 001
+// §3.4 breaks the mesh's springs by the same kind of criterion, over-extension). The tear then runs
+// straight through the ligament to that cut and the disc is free: a real capsule does not stop
+// 0.05 mm short of its own edge, where the flap-force rule would (the disc all but free, the pull
+// falls to 2–4 mN, far under F_c). The pull counts up to F_c (the tension at the tip plateaus
+// there; beyond it the forceps drag the disc), so physics alone would reach w ≤ F_c/(σ_u·h) =
+// δ_c/2 (G_c = σ_u·δ_c, above) ≈ 1.07 mm on the standard eye. Measured without either bound (the
+// pull 15.8 mN in the expert's final inward pull), the rule cut the last 1.5 mm by a chord (level
+// 3: 5.24 mm instead of 5.33). So the rule is the tear's last step only:
+// w at most max_step_mm, what one flap-force step crosses (a ligament the next step would cross
+// at F_c). A tear still far from its
+// start is held by a wide ligament and runs on by the rules above. Only the part of the path's own
+// cut that the tear has come round to counts: points of its trail (TearState) at least
+// kLigamentCurl times the ligament's width from the tip along the trail. A tear closing its circle
+// is ~16 mm round from its slit; a tear hooking back beside its own slit (level 1, two_level,
+// before the first grasp was moved: 0.87 mm along, 0.39 mm across) frees no disc, only a sliver.
+//
 // Reads: the cut mesh (positions, springs, topology), the path's tip and direction, the flap force.
 // Writes: the cut mesh and path (through the cut), the TearState's events.
 #include <cstdint>
@@ -67,6 +88,8 @@ struct TearSettings {
   double warn_lookahead_mm = 0.75;  // warn if heading to cross the safe circle within this
   double max_advance_mm = 1.0;      // tear_until_below: the most the tear runs in one frame,
   uint32_t max_steps = 16;          // in at most this many steps
+  // σ_u·h, mN/mm: a ligament of width w to the path's own start holds σ_u·h·w (above); 0: off.
+  double ligament_strength_mn_per_mm = 0.0;
 };
 
 // F_c = G_c·h/2 (trouser tear, above), mN, from the tearing energy in J/m² (= mN/mm) and the
@@ -89,6 +112,10 @@ struct TearState {
   bool torn_out = false;      // a runaway radial tear happened
   bool complete = false;      // the tear met the rim or the cut it started from
   double max_radius_mm = 0.0;
+  // The path as the tear has run it, for the ligament to its own start: the path's first vertex
+  // (the slit's start), the tip when the tear began, then the tip after each advance (positions
+  // as the edits see them: the rest shape in the scene). tear_step starts it.
+  std::vector<Vec3> trail;
   Vec3 front = Vec3::Zero();  // where the flap-force rule has taken the tear (the tip follows
   bool front_valid = false;   // it when snapping lets it)
   std::vector<TearEvent> events;
@@ -115,11 +142,23 @@ Vec3 flap_force_step(const Vec3& tip, const Vec3& normal, const Vec3& c_hat, con
 // kInvalidIndex. Springs along an opened cut (boundary edges behind the tip) are skipped.
 uint32_t most_stressed_spring_end(const cut::CutMesh& m, uint32_t tip, const TearSettings& s);
 
+// The ligament between a tear's tip and the path's own earlier cut (above): its width (the
+// distance from `tip` to the nearest point of the trail, TearState::trail, that the path has come
+// round to) and that point. found = false if the path has not come round.
+constexpr double kLigamentCurl = 8.0;
+struct Ligament {
+  bool found = false;
+  double width_mm = 0.0;
+  Vec3 to = Vec3::Zero();
+};
+Ligament own_ligament(const std::vector<Vec3>& trail, const Vec3& tip);
+
 struct TearStepReport {
   bool advanced = false;
   bool warned = false;
   bool torn_out = false;
   bool completed = false;
+  bool ligament_broke = false;  // the step broke the ligament to the path's own start
   double advance_mm = 0.0;  // how far the tear front moved (flap force) or the tip (spring rule)
   cut::SegmentReport segment;
 };

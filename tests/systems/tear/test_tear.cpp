@@ -194,5 +194,95 @@ TEST(TearUntilBelow, AFastPullStillPlateausBecauseTheTearRunsSeveralStepsAFrame)
   EXPECT_GT(peak, 3 * fc);
 }
 
+// The tear's last step (tear.hpp, "the ligament to its own start"): a path cut round three sides of
+// a rectangle on a 12 × 12 unit sheet and back down toward its first side, its tip `gap_mm` above
+// that side's middle. The pull is under F_c, as when the disc is all but free (2–4 mN in the
+// level-1 capsulorhexis that stalled 0.02–0.06 mm from its slit).
+struct LoopedTear {
+  cut::test::CutSheet sheet = cut::test::cut_sheet(phaco::test::grid_mesh(12, 0.0), 0.0);
+  cut::CutMesh m = sheet.mesh();
+  cut::CutPath path;
+  cut::EditLog log;
+  cut::CutSettings cs;
+  TearSettings t;
+  TearState state;
+  explicit LoopedTear(double gap_mm) {
+    for (const Vec3& p : {Vec3(2.3, 3.4, 0), Vec3(8.6, 3.4, 0), Vec3(8.6, 8.6, 0),
+                          Vec3(5.3, 8.6, 0), Vec3(5.3, 3.4 + gap_mm, 0)})
+      cut::cut_towards(m, path, p, cs, log), state.trail.push_back(p);
+    state.trail.back() = tip();  // as tear_step records it: the tip where the cut put it
+    t.threshold_mn = tear_resistance_mn(1500.0, 0.013);  // 9.75 mN
+    t.safe_radius_mm = 100.0;
+    t.ligament_strength_mn_per_mm = 700.0 * 0.013;  // σ_u·h of the standard eye, 9.1 mN/mm
+  }
+  Vec3 tip() const { return cut::particle_position(sheet.particles, path.tip); }
+};
+
+TEST(Ligament, OnlyThePartOfItsOwnCutATearHasComeRoundToCounts) {
+  LoopedTear near(0.25);
+  const Ligament l = own_ligament(near.state.trail, near.tip());
+  ASSERT_TRUE(l.found);
+  EXPECT_NEAR(l.width_mm, near.tip().y() - 3.4, 1e-9) << "to the first side, below the tip";
+  EXPECT_NEAR((l.to - Vec3(near.tip().x(), 3.4, 0)).norm(), 0.0, 1e-9);
+  // A straight cut and one turning by a right angle hold no ligament behind their tips.
+  cut::test::CutSheet s = cut::test::cut_sheet(phaco::test::grid_mesh(12, 0.0), 0.0);
+  cut::CutMesh m = s.mesh();
+  cut::CutPath path;
+  cut::EditLog log;
+  std::vector<Vec3> trail;
+  for (const Vec3& p : {Vec3(2.3, 3.4, 0), Vec3(8.6, 3.4, 0), Vec3(8.6, 8.6, 0)})
+    cut::cut_towards(m, path, p, {}, log), trail.push_back(p);
+  EXPECT_FALSE(own_ligament(trail, cut::particle_position(s.particles, path.tip)).found);
+  trail.pop_back();
+  EXPECT_FALSE(own_ligament(trail, Vec3(8.6, 3.4, 0)).found) << "straight";
+}
+
+TEST(Ligament, ASliverShortOfItsOwnStartBreaksUnderAPullUnderTheResistance) {
+  LoopedTear loop(0.25);
+  const double gap = loop.tip().y() - 3.4;
+  ASSERT_GT(gap, 0.1);
+  ASSERT_LT(gap, 0.25);
+  const Vec3 pull(0.0, 3.0, 0.0);  // 3 mN > σ_u·h·gap ≈ 1.8 mN, < F_c
+  TearSettings off = loop.t;
+  off.ligament_strength_mn_per_mm = 0.0;
+  TearStepReport r = tear_step(loop.m, loop.path, loop.state, pull, off, loop.cs, loop.log);
+  EXPECT_FALSE(r.advanced) << "without the rule the tear waits under F_c a sliver short";
+  EXPECT_FALSE(loop.state.complete);
+  // Wider than one tear step (max_step_mm 0.15 by default on this unit sheet): not the last step.
+  r = tear_step(loop.m, loop.path, loop.state, pull, loop.t, loop.cs, loop.log);
+  EXPECT_FALSE(r.ligament_broke);
+  EXPECT_FALSE(loop.state.complete);
+  loop.t.max_step_mm = 0.3;  // a tear stepping 0.3 mm: the gap is its last step
+  r = tear_step(loop.m, loop.path, loop.state, pull, loop.t, loop.cs, loop.log);
+  EXPECT_TRUE(r.ligament_broke);
+  EXPECT_TRUE(r.advanced);
+  EXPECT_TRUE(r.completed);
+  EXPECT_TRUE(loop.state.complete);
+  EXPECT_EQ(loop.state.count(TearEvent::Completed), 1u);
+  EXPECT_NEAR(loop.tip().x(), 5.3, 0.05) << "straight through the ligament";
+  EXPECT_NEAR(loop.tip().y(), 3.4, 0.05) << "onto the first side's lip";
+  EXPECT_TRUE(cut::test::sound(loop.sheet));
+}
+
+TEST(Ligament, ATearFarFromItsStartIsHeldAndRunsOnByTheFlapForce) {
+  LoopedTear loop(1.5);
+  const Vec3 before = loop.tip();
+  const Ligament l = own_ligament(loop.state.trail, before);
+  ASSERT_TRUE(l.found) << "the rule is asked, and declines";
+  EXPECT_GT(l.width_mm, 1.3);
+  // Just under F_c: the 1.5 mm ligament holds 13.65 mN; nothing tears.
+  TearStepReport r =
+      tear_step(loop.m, loop.path, loop.state, Vec3(0.0, -9.7, 0.0), loop.t, loop.cs, loop.log);
+  EXPECT_FALSE(r.ligament_broke);
+  EXPECT_FALSE(r.advanced);
+  EXPECT_EQ((loop.tip() - before).norm(), 0.0);
+  // Over F_c the flap-force rule runs the tear one step, not through to its start.
+  r = tear_step(loop.m, loop.path, loop.state, Vec3(0.0, -12.0, 0.0), loop.t, loop.cs, loop.log);
+  EXPECT_FALSE(r.ligament_broke);
+  EXPECT_FALSE(loop.state.complete);
+  EXPECT_LE(r.advance_mm, loop.t.max_step_mm + 1e-12);
+  EXPECT_TRUE(cut::test::sound(loop.sheet));
+}
+
 }  // namespace
 }  // namespace phaco::tear
