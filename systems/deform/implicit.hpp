@@ -108,11 +108,10 @@ struct ImplicitSettings {
   bool warm_start = true;
   CgOperator cg_operator =
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
-  // Block-Jacobi. Deflation needs ≤ 40 CG iterations per frame and runs on the team too, but its
-  // cost against block-Jacobi's is not yet measured on an idle machine, and the level-1 expert's
-  // rhexis closes or not with rounding-level differences of either solve
-  // (docs/implicit_and_active.md).
-  Preconditioner preconditioner = Preconditioner::BlockJacobi;
+  // Deflation: block-Jacobi with the active set's rigid and coarse modes projected out, a third
+  // of block-Jacobi's CG iterations on the capsule (33.5 against 95.6 per stepped frame at level
+  // 3), on the team like block-Jacobi (docs/implicit_and_active.md, "Deflation as the default").
+  Preconditioner preconditioner = Preconditioner::Deflation;
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a
   // small active set pays no threading overhead. Measured (docs/implicit_and_active.md).

@@ -3,7 +3,7 @@
 // the same carried eye; the incision the trainee cut is the next step's main port (turn the cut
 // and the port turns with it); the torn rhexis is the next step's opening; the sculpted trench is
 // the nucleus's groove; a complication fails the procedure, says why and leaves the rest unrun.
-// Level 0 meshes and shortened steps keep it to seconds.
+// Level 0 meshes (level 1 for the whole expert) and shortened steps keep it to seconds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -32,12 +32,12 @@ SceneOptions options() {
   return o;
 }
 
-// Steps in one eye at level 0; a positive duration cuts the step short.
-Procedure procedure_of(std::vector<std::pair<Scenario, double>> steps) {
+// Steps in one eye at `level` (0 unless said); a positive duration cuts the step short.
+Procedure procedure_of(std::vector<std::pair<Scenario, double>> steps, int level = 0) {
   Procedure p;
   p.source = "test procedure";
   for (auto& [s, duration] : steps) {
-    s.eye.level = 0;
+    s.eye.level = level;
     if (duration > 0) s.duration_s = duration;
     p.steps.push_back(s);
   }
@@ -59,10 +59,15 @@ Scenario turned_incision(double degrees) {
 }
 
 TEST(Procedure, TheExpertRunsEndToEndAndEachStepScoresAsItsDrillOnTheCarriedEye) {
+  // Level 1, as the expert's procedure file: on the level-0 mesh the expert's rhexis misses its
+  // size target (4.72 mm, under 5.0), and on so small an opening the later steps' shafts press
+  // its rim at about its strength, so whether they nick it turns on rounding (the implicit
+  // solve's preconditioner flips it; docs/procedures.md, "The rim's margin").
   const Procedure p = procedure_of({{test::repo_scenario("corneal_incision_expert.json"), 0},
                                     {test::repo_scenario("capsulorhexis_expert.json"), 0},
                                     {test::repo_scenario("phaco_sculpting_expert.json"), 0},
-                                    {test::repo_scenario("nucleus_removal_expert.json"), 8.0}});
+                                    {test::repo_scenario("nucleus_removal_expert.json"), 8.0}},
+                                   1);
   ProcedureState state = begin_procedure(p);
   std::vector<CarriedState> carried_in;
   double worst_off_port = 0;
