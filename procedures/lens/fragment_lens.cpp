@@ -101,37 +101,61 @@ void mark_boundary(FragmentLens& l) {
   auto& first = l.region_bin_first;
   auto& items = l.region_bin_items;
   const uint32_t bins = dims[0] * dims[1] * dims[2];
-  first.assign(size_t{bins} + 1, 0);
   auto each_bin = [&](const std::array<float, 6>& r, auto&& fn) {
-    for (uint32_t z = bin(2, r[2]); z <= bin(2, r[5]); ++z)
-      for (uint32_t y = bin(1, r[1]); y <= bin(1, r[4]); ++y)
-        for (uint32_t x = bin(0, r[0]); x <= bin(0, r[3]); ++x) fn((z * dims[1] + y) * dims[0] + x);
+    const uint32_t x0 = bin(0, r[0]), x1 = bin(0, r[3]), y0 = bin(1, r[1]), y1 = bin(1, r[4]);
+    const uint32_t z0 = bin(2, r[2]), z1 = bin(2, r[5]);
+    for (uint32_t z = z0; z <= z1; ++z)
+      for (uint32_t y = y0; y <= y1; ++y) {
+        const uint32_t row = (z * dims[1] + y) * dims[0];
+        for (uint32_t x = x0; x <= x1; ++x) fn(row + x);
+      }
   };
-  for (const auto& o : overlaps) each_bin(o.second, [&](uint32_t b) { ++first[b + 1]; });
-  for (uint32_t b = 0; b < bins; ++b) first[b + 1] += first[b];
+  // Counting sort of (bin, region): counts, running ends, then the regions from the last down,
+  // each taking the slot below its bin's end, so each bin lists its regions ascending and first[b]
+  // ends as the bin's start (no copy of the starts to fill from).
+  first.assign(size_t{bins} + 1, 0);
+  for (const auto& o : overlaps) each_bin(o.second, [&](uint32_t b) { ++first[b]; });
+  for (uint32_t b = 1; b < bins; ++b) first[b] += first[b - 1];
+  first[bins] = bins ? first[bins - 1] : 0;
   items.resize(first[bins]);
-  std::vector<uint32_t>& fill = l.region_bin_fill;
-  fill.assign(first.begin(), first.end() - 1);
-  for (uint32_t k = 0; k < overlaps.size(); ++k)
-    each_bin(overlaps[k].second, [&](uint32_t b) { items[fill[b]++] = k; });
-  parallel_for(0, n, kCellGrain, [&](uint32_t b, uint32_t e, int) {
-    for (uint32_t c = b; c < e; ++c) {
-      if (!l.boundary[c] || !l.cells.alive[c]) {
-        l.boundary[c] = 0;
-        continue;
-      }
-      const uint32_t f = l.fragments.label[c];
-      const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
-      uint8_t in = 0;
-      const uint32_t cell_bin = (bin(2, p[2]) * dims[1] + bin(1, p[1])) * dims[0] + bin(0, p[0]);
-      for (uint32_t i = first[cell_bin]; i < first[cell_bin + 1] && !in; ++i) {
-        const auto& [g, r] = overlaps[items[i]];
-        in = g == f && p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] &&
-             p[2] >= r[2] && p[2] <= r[5];
-      }
-      l.boundary[c] = in;
+  for (uint32_t k = static_cast<uint32_t>(overlaps.size()); k-- > 0;)
+    each_bin(overlaps[k].second, [&](uint32_t b) { items[--first[b]] = k; });
+  // Marks, and for the contact grid the marked cells in id order (collect_ids: the same list as a
+  // walk over every cell) and their box (min and max are exact in any order, NaN left out as
+  // build_grid does), without those two serial walks in sph::fragment_contact and build_grid.
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const uint32_t chunks =
+      (n + lens_tools::detail::kCollectChunk - 1) / lens_tools::detail::kCollectChunk;
+  l.boundary_chunk_box.assign(chunks, {kInf, kInf, kInf, -kInf, -kInf, -kInf});
+  lens_tools::detail::collect_ids(n, l.scan_ids, l.scan_counts, l.boundary_ids, [&](uint32_t c) {
+    if (!l.boundary[c] || !l.cells.alive[c]) {
+      l.boundary[c] = 0;
+      return false;
     }
+    const uint32_t f = l.fragments.label[c];
+    const float p[3] = {l.cells.x[c], l.cells.y[c], l.cells.z[c]};
+    uint8_t in = 0;
+    const uint32_t cell_bin = (bin(2, p[2]) * dims[1] + bin(1, p[1])) * dims[0] + bin(0, p[0]);
+    for (uint32_t i = first[cell_bin]; i < first[cell_bin + 1] && !in; ++i) {
+      const auto& [g, r] = overlaps[items[i]];
+      in = g == f && p[0] >= r[0] && p[0] <= r[3] && p[1] >= r[1] && p[1] <= r[4] && p[2] >= r[2] &&
+           p[2] <= r[5];
+    }
+    l.boundary[c] = in;
+    if (!in) return false;
+    auto& bx = l.boundary_chunk_box[c / lens_tools::detail::kCollectChunk];
+    for (int a = 0; a < 3; ++a) {
+      if (p[a] < bx[a]) bx[a] = p[a];
+      if (p[a] > bx[a + 3]) bx[a + 3] = p[a];
+    }
+    return true;
   });
+  l.boundary_box = {kInf, kInf, kInf, -kInf, -kInf, -kInf};
+  for (const auto& bx : l.boundary_chunk_box)
+    for (int a = 0; a < 3; ++a) {
+      if (bx[a] < l.boundary_box[a]) l.boundary_box[a] = bx[a];
+      if (bx[a + 3] > l.boundary_box[a + 3]) l.boundary_box[a + 3] = bx[a + 3];
+    }
 }
 
 // A new fragment starts from the rotation of the fragment it came from (no jump): l.fragment_of
@@ -207,8 +231,9 @@ void apply_contact(FragmentLens& l, FragmentLensStats& st, double dt_s) {
     l.pushed[c] = 0, l.fx[c] = 0.0f, l.fy[c] = 0.0f, l.fz[c] = 0.0f;
   if (l.fragments.count < 2) return;  // one body: no fragment contact to compute
   mark_boundary(l);
-  const sph::ContactParticles p{l.cells.x, l.cells.y, l.cells.z,         l.vx,
-                                l.vy,      l.vz,      l.fragments.label, l.boundary};
+  const sph::ContactParticles p{l.cells.x,      l.cells.y,      l.cells.z,         l.vx,
+                                l.vy,           l.vz,           l.fragments.label, l.boundary,
+                                l.boundary_ids, &l.boundary_box};
   const sph::ContactStats cs = sph::fragment_contact(p, l.fragments.count, l.settings.contact,
                                                      l.contact_scratch, l.fx, l.fy, l.fz);
   st.contact_particles = cs.particles;

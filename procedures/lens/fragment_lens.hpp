@@ -113,7 +113,10 @@ struct FragmentLens {
   std::vector<uint8_t> boundary;  // per cell: takes part in fragment contact this step
   std::vector<std::array<float, 6>> fragment_box;  // contact regions (fragment_lens.cpp)
   std::vector<uint32_t> fragment_order;
-  std::vector<uint32_t> region_bin_first, region_bin_items, region_bin_fill;  // regions by bin
+  std::vector<uint32_t> region_bin_first, region_bin_items;  // regions by bin
+  std::vector<uint32_t> boundary_ids;  // the cells with boundary set, ascending (mark_boundary)
+  std::vector<std::array<float, 6>> boundary_chunk_box;  // their box per collect_ids chunk
+  std::array<float, 6> boundary_box{};                   // and over all of them
   std::vector<std::pair<uint32_t, std::array<float, 6>>> overlaps;
   std::vector<uint8_t> pushed;  // per cell: fragment contact moved it this step
   std::vector<uint32_t> fragment_of;

@@ -223,13 +223,19 @@ ContactStats fragment_contact(const ContactParticles& in, uint32_t fragment_coun
   // Every column per particle, the forces too (a short one would be read or written past its end).
   assert(same_size(in.x, in.y, in.z, in.vx, in.vy, in.vz, in.fragment, in.boundary, fx, fy, fz));
   const auto n = static_cast<uint32_t>(in.x.size());
-  scratch.members.clear();
-  for (uint32_t i = 0; i < n; ++i)
-    if (in.boundary[i]) scratch.members.push_back(i);
+  if (!in.members.empty()) {
+    assert(std::is_sorted(in.members.begin(), in.members.end()) && all_below(in.members, n));
+    scratch.members.assign(in.members.begin(), in.members.end());
+  } else {
+    scratch.members.clear();
+    for (uint32_t i = 0; i < n; ++i)
+      if (in.boundary[i]) scratch.members.push_back(i);
+  }
   stats.particles = static_cast<uint32_t>(scratch.members.size());
   if (stats.particles < 2) return stats;
   Grid& g = scratch.grid;
-  build_grid(g, in.x, in.y, in.z, {}, params.h, params.order, scratch.members);
+  build_grid(g, in.x, in.y, in.z, {}, params.h, params.order, scratch.members,
+             in.members.empty() ? nullptr : in.members_box);
 
   const bool sorted = params.order != CellOrder::UnsortedHash;
   const ContactLaw law(params);

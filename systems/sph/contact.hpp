@@ -28,6 +28,7 @@
 // argument one level finer, decided once per cell and octant).
 //
 // Reads: positions, velocities, fragment labels, boundary flags. Writes: forces (added, mN).
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -48,6 +49,11 @@ struct ContactParticles {
   std::span<const float> vx, vy, vz;   // mm/s
   std::span<const uint32_t> fragment;  // fragment label per particle
   std::span<const uint8_t> boundary;   // 1: a boundary cell, takes part in contact
+  // Optional: the particles with boundary set, ascending, when the caller already has them (a
+  // parallel pass of its own); empty: fragment_contact walks `boundary` for them. With them,
+  // optionally their box (build_grid's `box`: min x, y, z, max x, y, z, NaN left out).
+  std::span<const uint32_t> members;
+  const std::array<float, 6>* members_box = nullptr;
 };
 
 struct ContactScratch {

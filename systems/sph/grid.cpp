@@ -56,25 +56,40 @@ bool inside(const Grid& g, int64_t ix, int64_t iy, int64_t iz) {
   return ix >= 0 && iy >= 0 && iz >= 0 && ix < g.dims[0] && iy < g.dims[1] && iz < g.dims[2];
 }
 
-// Stable LSD radix sort of (key, id) by key, 8 bits per pass, skipping passes whose digit is the
-// same for every key.
+// Stable LSD radix sort of (key, id) by key. The keys' significant bits are split into the fewest
+// digits of at most kGridRadixBits (the lens contact grids' 17-22-bit keys: two passes, where
+// 8-bit digits took three), and every pass's histogram is counted in one read of the keys. A pass
+// whose digit is the same for every key is skipped. Any split of the bits gives the one stable
+// order by key, so the grid is the same.
+constexpr int kGridRadixBits = 11;
+
 void radix_sort(Grid& g, uint32_t n) {
   uint64_t all_or = 0;
   for (uint32_t i = 0; i < n; ++i) all_or |= g.key[i];
   const int bits = 64 - std::countl_zero(all_or);
-  g.histogram.assign(256, 0);
-  for (int shift = 0; shift < bits; shift += 8) {
-    std::fill(g.histogram.begin(), g.histogram.end(), 0u);
-    for (uint32_t i = 0; i < n; ++i) ++g.histogram[(g.key[i] >> shift) & 0xff];
-    if (g.histogram[(g.key[0] >> shift) & 0xff] == n) continue;  // one digit: nothing moves
+  if (bits == 0) return;  // every key 0: already in order
+  const int passes = (bits + kGridRadixBits - 1) / kGridRadixBits;
+  const int width = (bits + passes - 1) / passes;
+  const uint32_t radix = 1u << width;
+  const uint64_t mask = radix - 1;
+  g.histogram.assign(size_t{radix} * passes, 0);
+  uint32_t* const hist = g.histogram.data();
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint64_t k = g.key[i];
+    for (int p = 0; p < passes; ++p) ++hist[p * radix + ((k >> (p * width)) & mask)];
+  }
+  for (int p = 0; p < passes; ++p) {
+    uint32_t* const h = hist + static_cast<size_t>(p) * radix;
+    const int shift = p * width;
+    if (h[(g.key[0] >> shift) & mask] == n) continue;  // one digit: nothing moves
     uint32_t sum = 0;
-    for (uint32_t& h : g.histogram) {
-      const uint32_t c = h;
-      h = sum;
+    for (uint32_t d = 0; d < radix; ++d) {
+      const uint32_t c = h[d];
+      h[d] = sum;
       sum += c;
     }
     for (uint32_t i = 0; i < n; ++i) {
-      const uint32_t dst = g.histogram[(g.key[i] >> shift) & 0xff]++;
+      const uint32_t dst = h[(g.key[i] >> shift) & mask]++;
       g.key_tmp[dst] = g.key[i];
       g.id_tmp[dst] = g.id[i];
     }
@@ -163,7 +178,7 @@ void fill_cell_table(Grid& g, uint32_t n, bool sub) {
 
 void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
                 std::span<const float> z, std::span<const float> mass, float h, CellOrder order,
-                std::span<const uint32_t> subset) {
+                std::span<const uint32_t> subset, const std::array<float, 6>* box) {
   assert(same_size(x, y, z) && (mass.empty() || same_size(x, mass)) && all_below(subset, x.size()));
   const uint32_t n =
       subset.empty() ? static_cast<uint32_t>(x.size()) : static_cast<uint32_t>(subset.size());
@@ -194,7 +209,8 @@ void build_grid(Grid& g, std::span<const float> x, std::span<const float> y,
 
   // Bounds (min/max are exact, so the order of this loop does not matter). NaN never wins.
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (uint32_t i = 0; i < n; ++i) {
+  for (int a = 0; box && a < 3; ++a) lo[a] = (*box)[a], hi[a] = (*box)[a + 3];
+  for (uint32_t i = 0; !box && i < n; ++i) {
     const uint32_t p = particle(i);
     const double v[3] = {x[p], y[p], z[p]};
     for (int a = 0; a < 3; ++a) {

@@ -125,9 +125,11 @@ inline constexpr uint64_t kEmptyKey = ~uint64_t{0};
 
 // Builds the grid over the particles listed in `subset` (all of them when empty). `mass` may be
 // empty (unit masses). h > 0.
+// `box`, when given, is the particles' min x, y, z and max x, y, z as build_grid's own pass would
+// find them (NaN coordinates left out), from a pass of the caller's over them anyway.
 void build_grid(Grid& grid, std::span<const float> x, std::span<const float> y,
                 std::span<const float> z, std::span<const float> mass, float h, CellOrder order,
-                std::span<const uint32_t> subset = {});
+                std::span<const uint32_t> subset = {}, const std::array<float, 6>* box = nullptr);
 
 // Cell keys.
 uint64_t morton_key(uint32_t ix, uint32_t iy, uint32_t iz);

@@ -3,6 +3,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -358,6 +359,41 @@ TEST(SphContact, ForcesAreBitIdenticalForOneAndTwoThreads) {
     EXPECT_EQ(st[0].pairs, st[1].pairs);
     EXPECT_EQ(0, std::memcmp(out[0].data(), out[1].data(), out[0].size() * sizeof(float)))
         << to_string(order);
+  }
+}
+
+// A caller's own list of the boundary particles and their box (fragment_lens' mark_boundary) give
+// the forces of fragment_contact's own walk and bounds, to the bit, in every order.
+TEST(SphContact, GivenMembersAndBoxGiveTheForcesOfTheWalk) {
+  const Bodies b = interleaved(6000, 5);
+  ContactParams p;
+  p.h = 0.03f, p.stiffness = 1.0f, p.damping = 1e-6f;
+  std::vector<uint32_t> members;
+  std::array<float, 6> box{1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
+  for (uint32_t i = 0; i < b.size(); ++i) {
+    if (!b.boundary[i]) continue;
+    members.push_back(i);
+    const float q[3] = {b.x[i], b.y[i], b.z[i]};
+    for (int a = 0; a < 3; ++a)
+      box[a] = std::min(box[a], q[a]), box[a + 3] = std::max(box[a + 3], q[a]);
+  }
+  for (CellOrder order : kOrders) {
+    p.order = order;
+    Forces walked(b.size()), given(b.size());
+    ContactScratch s0, s1;
+    const ContactStats st0 = fragment_contact(b.view(), 2, p, s0, walked.x, walked.y, walked.z);
+    ContactParticles in = b.view();
+    in.members = members;
+    in.members_box = &box;
+    const ContactStats st1 = fragment_contact(in, 2, p, s1, given.x, given.y, given.z);
+    EXPECT_GT(st0.pairs, 500u) << to_string(order);
+    EXPECT_EQ(st0.pairs, st1.pairs) << to_string(order);
+    EXPECT_EQ(s0.members, s1.members) << to_string(order);
+    EXPECT_EQ(s0.grid.origin[0], s1.grid.origin[0]) << to_string(order);
+    for (const auto& [w, g] :
+         {std::pair{&walked.x, &given.x}, {&walked.y, &given.y}, {&walked.z, &given.z}})
+      EXPECT_EQ(0, std::memcmp(w->data(), g->data(), w->size() * sizeof(float)))
+          << to_string(order);
   }
 }
 
