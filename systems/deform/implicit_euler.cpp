@@ -296,6 +296,20 @@ void row_terms(const Membrane& m, double dt, ImplicitCache& cache, uint32_t ub, 
 
 // Two phases on the step's team: the springs, then the rows, each in an even number of equal
 // chunks (the team's two threads start from opposite ends).
+// Deflation's CG waits in every iteration while one thread solves the coarse system, so on the
+// active sets the drills step it lost to one thread: the capsulorhexis expert's frame mean was
+// 0.74–0.82× as fast on 2 threads as on 1 at every level 0–8 (`phaco-perf sweep`, session 37;
+// sets of up to 1,513 nodes at level 8). Below this many nodes its step keeps to the calling
+// thread; the results are the same bits either way (the team's sums do not depend on it). Above
+// it the team is not measured: no drill reaches it.
+constexpr uint32_t kDeflationTeamMinNodes = 4096;
+
+uint32_t team_min_nodes(const ImplicitSettings& settings) {
+  return settings.preconditioner == Preconditioner::Deflation
+             ? std::max(settings.cg_team_min_rows, kDeflationTeamMinNodes)
+             : settings.cg_team_min_rows;
+}
+
 void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& team) {
   const uint32_t nu = static_cast<uint32_t>(cache.unknowns.particles.size());
   const uint32_t ns = static_cast<uint32_t>(cache.unknowns.springs.size());
@@ -345,7 +359,7 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
   // and assembles (engine/schedule/phased_team.hpp). Let go before the solve if the solve is
   // Eigen's, whose parallel loops need the worker free.
   std::optional<PhasedTeam> team;
-  team.emplace(nu >= cache.settings.cg_team_min_rows);
+  team.emplace(nu >= team_min_nodes(cache.settings));
   assemble(m, dt, cache, *team);
   const bool row_chunked = cache.settings.cg_operator == CgOperator::MatrixFree &&
                            implicit_detail::team_cg_preconditioner(cache.settings.preconditioner);
