@@ -108,9 +108,10 @@ struct ImplicitSettings {
   bool warm_start = true;
   CgOperator cg_operator =
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
-  // Deflation: block-Jacobi with the active set's rigid and coarse modes projected out, a third
-  // of block-Jacobi's CG iterations on the capsule (33.5 against 95.6 per stepped frame at level
-  // 3), on the team like block-Jacobi (docs/implicit_and_active.md, "Deflation as the default").
+  // Deflation: block-Jacobi with a coarse space of node aggregates projected out, a third of
+  // block-Jacobi's CG iterations on the capsule (33.5 against 95.6 per stepped frame at level 3)
+  // at about its time; on the team only from 4096 nodes (implicit_euler.cpp), since its team
+  // waits at the serial coarse solve (docs/implicit_and_active.md, "Session 37").
   Preconditioner preconditioner = Preconditioner::Deflation;
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a
