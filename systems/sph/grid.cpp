@@ -57,8 +57,9 @@ bool inside(const Grid& g, int64_t ix, int64_t iy, int64_t iz) {
 }
 
 // Stable LSD radix sort of (key, id) by key. The keys' significant bits are split into the fewest
-// digits of at most kGridRadixBits (the lens contact grids' 17-22-bit keys: two passes, where
-// 8-bit digits took three), and every pass's histogram is counted in one read of the keys. A pass
+// digits of at most kGridRadixBits, and every pass's histogram is counted in one read of the keys
+// (the lens contact grids' keys, about 15-16 bits, still take two passes: the gain is that one
+// read, not a pass; keys of 17-22 bits would take two where 8-bit digits took three). A pass
 // whose digit is the same for every key is skipped. Any split of the bits gives the one stable
 // order by key, so the grid is the same.
 constexpr int kGridRadixBits = 11;
