@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "procedures/haptics/haptic_session.hpp"
+#include "procedures/scene/run.hpp"
 #include "procedures/scene/scene.hpp"
 
 namespace phaco {
@@ -39,6 +40,9 @@ struct RealtimeRunReport {
   uint64_t late_frames = 0;  // started more than one dt after their deadline
   double max_lag_ms = 0;     // the latest a frame started after its deadline
   uint32_t restarts = 0;     // scenario restarted (loop_scenario)
+  // Each system's cost over the last scene's frames (a restart begins a new scene): where a
+  // frame's time goes with the haptic thread beside the simulation.
+  std::vector<SystemCost> systems;
   HapticSessionStats haptics;
 };
 

@@ -15,7 +15,6 @@
 
 namespace phaco {
 
-namespace {
 SystemCost cost_of(const SystemTiming& t) {
   SystemCost c{t.name, t.p50_ms(), t.p99_ms(), 0.0, t.percentile_ms(100)};
   if (!t.samples_ms.empty()) {
@@ -24,7 +23,6 @@ SystemCost cost_of(const SystemTiming& t) {
   }
   return c;
 }
-}  // namespace
 
 double peak_memory_mb() {
   rusage usage{};
@@ -41,6 +39,14 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options) {
   RunReport r = report_of(*scene);
   r.wall_time_s = wall_s;
   return r;
+}
+
+nlohmann::json systems_json(const std::vector<SystemCost>& systems) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const SystemCost& s : systems)
+    j[s.name] = {
+        {"p50_ms", s.p50_ms}, {"p99_ms", s.p99_ms}, {"mean_ms", s.mean_ms}, {"max_ms", s.max_ms}};
+  return j;
 }
 
 RunReport report_of(Scene& scene) {
@@ -86,12 +92,7 @@ nlohmann::json to_json(const RunReport& r) {
   j["dt_s"] = r.dt_s;
   j["frames"] = r.frames;
   j["threads"] = r.threads;
-  nlohmann::json systems = nlohmann::json::object();
-  for (const auto& s : r.systems) {
-    systems[s.name] = {
-        {"p50_ms", s.p50_ms}, {"p99_ms", s.p99_ms}, {"mean_ms", s.mean_ms}, {"max_ms", s.max_ms}};
-  }
-  j["systems"] = systems;
+  j["systems"] = systems_json(r.systems);
   j["frame"] = {{"p50_ms", r.frame.p50_ms},
                 {"p99_ms", r.frame.p99_ms},
                 {"mean_ms", r.frame.mean_ms},

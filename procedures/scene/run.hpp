@@ -50,6 +50,11 @@ RunReport run_scenario(const Scenario& scenario, const SceneOptions& options);
 // scene at its end): what ran, each system's cost, the sizes, the drill's metrics, the physics
 // summaries and the state hash. wall_time_s is left 0: only the caller knows what it timed.
 RunReport report_of(Scene& scene);
+
+// One system's (or the frame's) cost over the frames its executor has timed.
+SystemCost cost_of(const SystemTiming& timing);
+// {name: {p50_ms, p99_ms, mean_ms, max_ms}}, the report's "systems".
+nlohmann::json systems_json(const std::vector<SystemCost>& systems);
 nlohmann::json to_json(const RunReport& report);
 std::string summary_text(const RunReport& report);
 // Peak resident set size of this process so far, MiB.

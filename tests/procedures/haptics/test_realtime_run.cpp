@@ -50,6 +50,30 @@ TEST(RealtimeRun, AScriptedDeviceDrivesTheSceneInRealTime) {
   EXPECT_NE(summary_text(r).find("haptic thread"), std::string::npos);
 }
 
+// A run as long as its scenario steps that scenario once: the step before the haptic thread
+// starts made the run restart the scene for its last frame, and report on that fresh scene.
+TEST(RealtimeRun, ARunAsLongAsItsScenarioKeepsItsSceneAndReportsItsSystems) {
+  Scenario s = test::repo_scenario("capsulorhexis_demo.json");
+  s.duration_s = 0.5;
+  HapticSession session(quiet_config());
+  session.attach(Hand::Left, std::make_unique<ScriptedDevice>(*s.find_hand(Hand::Left)));
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  RealtimeRunOptions run;  // duration 0: the scenario's
+  uint64_t last_frame = 0;
+  run.at_end = [&](Scene& scene) { last_frame = scene.frame; };
+  const RealtimeRunReport r = run_realtime(s, o, session, run);
+  EXPECT_EQ(r.restarts, 0u);
+  EXPECT_EQ(r.frames, s.frame_count());
+  EXPECT_EQ(last_frame, s.frame_count() + 1) << "the step before the start and the run's frames";
+  // Each system's cost over those frames, as `phaco run --json` gives them.
+  const nlohmann::json j = to_json(r);
+  ASSERT_TRUE(j["systems"].contains("capsule_dynamics"));
+  EXPECT_GT(j["systems"]["capsule_dynamics"]["mean_ms"].get<double>(), 0.0);
+  EXPECT_LE(j["systems"]["capsule_dynamics"]["p50_ms"].get<double>(),
+            j["systems"]["capsule_dynamics"]["max_ms"].get<double>());
+}
+
 TEST(RealtimeRun, AStalledSimulationLeavesTheHapticThreadRunning) {
   const Scenario s = test::repo_scenario("capsulorhexis_demo.json");
   HapticSession session(quiet_config());

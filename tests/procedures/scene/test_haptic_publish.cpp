@@ -333,6 +333,78 @@ TEST(HapticPublish, TheSculptedLensComesAsSpheresOfItsMaterialNearTheTip) {
   EXPECT_TRUE(saw_probe);
 }
 
+// A fragment lens's cells a tool should feel, by a plain scan of every cell in double: alive, with
+// an external face, not of the held fragment, gap to the tip within the tool's reach; nearest
+// first (ties by id), at most kHapticMaxSpheres.
+std::vector<std::pair<float, uint32_t>> nearest_outer_cells(const LensFragments& lf,
+                                                            const HapticTool& t, const Vec3& tip,
+                                                            double reach_mm) {
+  const SimplexCells& cells = lf.lens.cells;
+  const double reach = t.tip_radius_mm + reach_mm;
+  std::vector<std::pair<float, uint32_t>> want;
+  for (uint32_t c = 0; c < cells.size(); ++c) {
+    if (!cells.alive[c]) continue;
+    if (t.held.held && lf.lens.fragments.label[c] == t.held.fragment) continue;
+    bool outer = false;
+    for (uint32_t k = 0; k < 4; ++k) outer |= cells.neighbour[c][k] == kNoSimplex;
+    if (!outer) continue;
+    const double dx = cells.x[c] - tip.x(), dy = cells.y[c] - tip.y(), dz = cells.z[c] - tip.z();
+    const double gap =
+        std::sqrt(dx * dx + dy * dy + dz * dz) -
+        std::cbrt(3.0 * std::max(0.0, static_cast<double>(cells.volume[c])) / (4.0 * M_PI));
+    if (gap <= reach) want.emplace_back(static_cast<float>(gap), c);
+  }
+  std::sort(want.begin(), want.end());
+  want.resize(std::min<size_t>(want.size(), kHapticMaxSpheres));
+  return want;
+}
+
+// The nucleus drill's two tips, probe and chopper, inside a cracked lens: each tool's spheres are
+// the nearest outer cells within its reach that a plain scan of every cell in double finds, whether
+// the publisher scanned the centres once for both tips (scan_lens_cells) or each tip alone.
+TEST(HapticPublish, OneScanForBothTipsFindsWhatAPlainScanOfEveryCellFinds) {
+  CapturePort port;
+  Scenario s = test::repo_scenario("nucleus_removal_expert.json");
+  s.eye.level = 0;
+  SceneOptions o;
+  o.cache_dir = test::scene_cache_dir();
+  o.haptics = &port;
+  auto scene = build_scene(s, o);
+  const LensFragments& lf = scene->world.at<LensFragments>(*scene->body(BodyPart::Lens));
+  const SimplexCells& cells = lf.lens.cells;
+  const HapticPublishSettings settings = haptic_publish_settings(*scene);
+  const auto expect_spheres = [&](const HapticTool& t,
+                                  const std::vector<std::pair<float, uint32_t>>& want,
+                                  const char* how) {
+    ASSERT_EQ(t.sphere_count, want.size()) << how;
+    for (uint32_t j = 0; j < t.sphere_count; ++j) {
+      const uint32_t c = want[j].second;
+      EXPECT_EQ(t.sphere_x[j], cells.x[c]) << how << " " << j;
+      EXPECT_EQ(t.sphere_y[j], cells.y[c]) << how << " " << j;
+      EXPECT_EQ(t.sphere_z[j], cells.z[c]) << how << " " << j;
+    }
+  };
+  // Checked at three moments of the expert's first 25 s (both tips at work in the lens).
+  int checked_with_spheres = 0;
+  for (const double at_s : {8.0, 16.0, 25.0}) {
+    while (scene->time_s < at_s) step(*scene);
+    for (const Entity e : scene->tools) {
+      const HapticTool& t =
+          port.slot.tools[static_cast<size_t>(scene->world.at<Tool>(e).hand) % kHapticTools];
+      const auto want =
+          nearest_outer_cells(lf, t, scene->world.at<ToolState>(e).pos, settings.lens.reach_mm);
+      expect_spheres(t, want, "published");
+      checked_with_spheres += want.empty() ? 0 : 1;
+      // The same tool's spheres from a scratch that scanned nothing: its own scan.
+      HapticLensScratch alone;
+      HapticTool u = t;
+      fill_lens_contacts(*scene, e, settings.lens, alone, u);
+      expect_spheres(u, want, "scanned alone");
+    }
+  }
+  EXPECT_GE(checked_with_spheres, 3) << "tips near the lens at least three times";
+}
+
 // The fragment lens: boundary cells near the tip, and a held fragment's record copied as is with
 // its own cells left out (they ride the tip).
 TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsRecord) {
@@ -373,24 +445,10 @@ TEST(HapticPublish, TheFragmentLensComesAsItsBoundaryCellsAndAHeldFragmentAsItsR
   // every cell in double finds (the publisher's float pre-test only drops cells beyond reach).
   {
     const SimplexCells& cells = lf.lens.cells;
-    const double reach = t.tip_radius_mm + haptic_publish_settings(*scene).lens.reach_mm;
-    std::vector<std::pair<float, uint32_t>> want;
-    for (uint32_t c = 0; c < cells.size(); ++c) {
-      if (!cells.alive[c]) continue;
-      if (t.held.held && lf.lens.fragments.label[c] == t.held.fragment) continue;
-      bool outer = false;
-      for (uint32_t k = 0; k < 4; ++k) outer |= cells.neighbour[c][k] == kNoSimplex;
-      if (!outer) continue;
-      const double dx = cells.x[c] - pose.pos.x(), dy = cells.y[c] - pose.pos.y(),
-                   dz = cells.z[c] - pose.pos.z();
-      const double gap =
-          std::sqrt(dx * dx + dy * dy + dz * dz) -
-          std::cbrt(3.0 * std::max(0.0, static_cast<double>(cells.volume[c])) / (4.0 * M_PI));
-      if (gap <= reach) want.emplace_back(static_cast<float>(gap), c);
-    }
-    std::sort(want.begin(), want.end());
+    const auto want =
+        nearest_outer_cells(lf, t, pose.pos, haptic_publish_settings(*scene).lens.reach_mm);
     ASSERT_GT(want.size(), 0u);
-    ASSERT_EQ(t.sphere_count, std::min<size_t>(want.size(), kHapticMaxSpheres));
+    ASSERT_EQ(t.sphere_count, want.size());
     for (uint32_t j = 0; j < t.sphere_count; ++j) {
       const uint32_t c = want[j].second;
       EXPECT_EQ(t.sphere_x[j], cells.x[c]) << j;
