@@ -275,13 +275,14 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
   const bool has_lens = scene.body(BodyPart::Lens) || scene.body(BodyPart::LensSurface);
   const bool sculptable_lens = has_sculptable_lens(scene);
   if (has_capsule_physics) track_capsule_particles(scene, *capsule, settings, scratch);
-  if (sculptable_lens) {  // a fragment lens's cells near every tip, in one read of the centres
-    scratch.tip_radius_mm.clear();
-    for (const Entity e : scene.tools)
-      scratch.tip_radius_mm.push_back(static_cast<float>(haptic_tip_radius_mm(
-          scene, static_cast<uint8_t>(scene.world.get<Tool>(e)->kind))));  // as HapticTool has it
+  // Each tool's tip radius, as HapticTool holds it (float), found once for the scan and the tool.
+  scratch.tip_radius_mm.clear();
+  for (const Entity e : scene.tools)
+    scratch.tip_radius_mm.push_back(static_cast<float>(
+        haptic_tip_radius_mm(scene, static_cast<uint8_t>(scene.world.get<Tool>(e)->kind))));
+  // A fragment lens's cells near every tip, in one read of the centres.
+  if (sculptable_lens)
     scan_lens_cells(scene, scene.tools, scratch.tip_radius_mm, settings.lens, scratch.lens);
-  }
   const PortsRecord* ports = ports_record(scene);
   for (size_t index = 0; index < scene.tools.size(); ++index) {
     const Entity e = scene.tools[index];
@@ -291,7 +292,7 @@ void build_haptic_model(const Scene& scene, const HapticPublishSettings& setting
     t.present = true;
     t.tool_kind = static_cast<uint8_t>(tool.kind);
     t.hand = static_cast<uint8_t>(tool.hand);
-    t.tip_radius_mm = static_cast<float>(haptic_tip_radius_mm(scene, t.tool_kind));
+    t.tip_radius_mm = static_cast<float>(scratch.tip_radius_mm[index]);
     t.tip_mm = {static_cast<float>(pose.pos.x()), static_cast<float>(pose.pos.y()),
                 static_cast<float>(pose.pos.z())};
 

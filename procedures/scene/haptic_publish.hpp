@@ -57,7 +57,7 @@ struct HapticPublishScratch {
   std::vector<uint32_t> fan;                               // one node's triangles
   point_bins::PointBins bins;  // the capsule's particles, for the nearest
   HapticLensScratch lens;
-  std::vector<double> tip_radius_mm;  // per scene tool, for scan_lens_cells
+  std::vector<double> tip_radius_mm;  // per scene tool (its tip sphere, mm)
 };
 
 // The settings from the eye parameters' haptic_model section.
