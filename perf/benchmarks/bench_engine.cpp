@@ -2,8 +2,14 @@
 //   build/release/perf/bench_engine --benchmark_min_time=0.2
 #include <benchmark/benchmark.h>
 #include <oneapi/tbb/task_arena.h>
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
 
+#include <atomic>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "engine/core/rng.hpp"
@@ -12,6 +18,7 @@
 #include "engine/schedule/executor.hpp"
 #include "engine/schedule/frame_graph.hpp"
 #include "engine/schedule/parallel.hpp"
+#include "engine/schedule/phased_team.hpp"
 
 namespace phaco {
 namespace {
@@ -40,6 +47,136 @@ void BM_ExecutorFrame(benchmark::State& state) {
   state.counters["systems"] = n;
 }
 BENCHMARK(BM_ExecutorFrame)->ArgsProduct({{2, 8, 32, 128}, {1, 2}})->Unit(benchmark::kMicrosecond);
+
+// The lowest and highest CPU the calling thread may run on (-1, -1 with fewer than two).
+std::pair<int, int> two_cpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) != 0 || CPU_COUNT(&set) < 2)
+    return {-1, -1};
+  int low = -1, high = -1;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (!CPU_ISSET(c, &set)) continue;
+    if (low < 0) low = c;
+    high = c;
+  }
+  return {low, high};
+}
+
+void pin_to(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+}
+
+// One round trip of a cache line between two cores: the floor under every handoff of a team of
+// two threads (PhasedTeam's phase opening, a chunk claim). Session 40's 2-vCPU VM, as the host
+// moved its two vCPUs within minutes: 440–480 ns (apart), 112–117 ns (near), 70–80 ns (two
+// hardware threads of one core: two compute loops then ran 1.3× slower side by side than alone).
+// BM_PhasedTeamPhases on 2 threads ran 1.4–1.8× as fast as on 1 in the first two and 0.67× in
+// the third (systems/deform/team_choice.hpp).
+void BM_CoreRoundTrip(benchmark::State& state) {
+  const auto [first, last] = two_cpus();
+  if (first < 0) {
+    state.SkipWithError("needs two CPUs");
+    return;
+  }
+  std::atomic<int64_t> ball{0};
+  std::atomic<bool> done{false};
+  std::thread partner([&] {
+    pin_to(last);
+    for (int64_t seen = 1;; seen += 2) {
+      while (ball.load(std::memory_order_acquire) != seen)
+        if (done.load(std::memory_order_relaxed)) return;
+      ball.store(seen + 1, std::memory_order_release);
+    }
+  });
+  cpu_set_t before;
+  pthread_getaffinity_np(pthread_self(), sizeof(before), &before);
+  pin_to(first);
+  int64_t served = 1;
+  for (auto _ : state) {
+    ball.store(served, std::memory_order_release);
+    while (ball.load(std::memory_order_acquire) != served + 1) {
+    }
+    served += 2;
+  }
+  done.store(true, std::memory_order_relaxed);
+  partner.join();
+  pthread_setaffinity_np(pthread_self(), sizeof(before), &before);
+}
+BENCHMARK(BM_CoreRoundTrip)->Unit(benchmark::kNanosecond)->UseRealTime();
+
+// A 1 kHz thread beside the benchmark, as the haptic loop is beside the frames: it sleeps to each
+// deadline (SCHED_FIFO if granted) and then works `busy_us`, so it takes a core ~1000 times a
+// second.
+class KiloHertzNeighbour {
+ public:
+  explicit KiloHertzNeighbour(int busy_us) {
+    thread_ = std::thread([this, busy_us] {
+      sched_param param{};
+      param.sched_priority = 80;
+      pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+      timespec t;
+      clock_gettime(CLOCK_MONOTONIC, &t);
+      int64_t next = int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+      while (!stop_.load(std::memory_order_relaxed)) {
+        next += 1'000'000;
+        const timespec wake{time_t(next / 1'000'000'000), long(next % 1'000'000'000)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr);
+        for (int64_t now = next; now < next + busy_us * 1000;) {
+          clock_gettime(CLOCK_MONOTONIC, &t);
+          now = int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+        }
+      }
+    });
+  }
+  ~KiloHertzNeighbour() {
+    stop_.store(true, std::memory_order_relaxed);
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// A PhasedTeam's phases at about the size of a CG iteration's phases on the capsule's active
+// set (issue 17): 150 phases of 12 chunks over 6,000 doubles, each chunk a few µs, the team formed
+// once per run as in implicit_euler_step. Arguments: threads (1, 2) and the neighbour's busy time
+// per tick in µs (-1: no neighbour). Session 40's VM, three runs with the vCPUs on two cores:
+// 2 threads 1.4–1.8× as fast as 1 with no neighbour, with a neighbour busy 0 µs a tick and with
+// one busy 150 µs; so the team itself survives a 1 kHz thread beside it (on one core's two
+// hardware threads it lost: BM_CoreRoundTrip above).
+void BM_PhasedTeamPhases(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  const int busy_us = static_cast<int>(state.range(1));
+  constexpr uint32_t kRows = 6000, kChunks = 12, kPhases = 150;
+  std::vector<double> x(kRows, 1.0), y(kRows, 2.0);
+  std::optional<KiloHertzNeighbour> neighbour;
+  if (busy_us >= 0) neighbour.emplace(busy_us);
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    for (auto _ : state) {
+      PhasedTeam team(threads > 1);
+      team.run(
+          kChunks, kPhases, [](uint64_t) { return true; },
+          [&](uint64_t phase, uint32_t chunk) {
+            const uint32_t per = kRows / kChunks, begin = chunk * per, end = begin + per;
+            for (int pass = 0; pass < 4; ++pass)
+              for (uint32_t i = begin; i < end; ++i)
+                x[i] = x[i] * 0.999 + y[i] * 1e-3 * double(phase & 1);
+          });
+      benchmark::DoNotOptimize(x.data());
+    }
+  });
+  state.counters["phases"] = kPhases;
+}
+BENCHMARK(BM_PhasedTeamPhases)
+    ->ArgsProduct({{1, 2}, {-1, 0, 150}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // parallel_for dispatch over 128k elements doing one fused multiply-add each.
 void BM_ParallelForStream(benchmark::State& state) {

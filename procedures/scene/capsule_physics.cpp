@@ -227,6 +227,9 @@ nlohmann::json capsule_physics_summary(const Scene& scene) {
           {"max_speed_mm_s", st.max_speed_mm_s},
           {"cg_iterations_total", implicit.stats.cg_iterations_total},
           {"cg_iterations_per_step_mean", cg_per_step},
+          // Steps run on the team of two: chosen by timing (team_choice.hpp), so it varies from
+          // run to run where the state hash does not.
+          {"team_steps", implicit.stats.team_steps},
           {"preconditioner", std::string(to_string(implicit.settings.preconditioner))},
           {"preconditioner_builds", implicit.stats.preconditioner_builds},
           {"implicit_pattern_builds", implicit.stats.pattern_builds},

@@ -87,6 +87,7 @@
 #include <vector>
 
 #include "systems/deform/membrane.hpp"
+#include "systems/deform/team_choice.hpp"
 
 namespace phaco::deform {
 
@@ -102,6 +103,8 @@ enum class Preconditioner : uint8_t {
   Balancing
 };
 
+enum class TeamPolicy { Timed, Always };
+
 struct ImplicitSettings {
   double cg_tolerance = 1.0e-6;  // relative residual
   int cg_max_iterations = 1000;
@@ -110,8 +113,7 @@ struct ImplicitSettings {
       CgOperator::MatrixFree;  // measured 3× faster (docs/implicit_and_active.md)
   // Deflation: block-Jacobi with a coarse space of node aggregates projected out, a third of
   // block-Jacobi's CG iterations on the capsule (33.5 against 95.6 per stepped frame at level 3)
-  // at about its time; on the team only from 4096 nodes (implicit_euler.cpp), since its team
-  // waits at the serial coarse solve (docs/implicit_and_active.md, "Session 37").
+  // at about its time; on the team where the team measured cheaper (team_policy).
   Preconditioner preconditioner = Preconditioner::Deflation;
   // The matrix-free product and the block preconditioners split their rows over threads from this
   // many unknowns on (chunks of parallel_grain_unknowns rows); below it they run serially, so a
@@ -127,6 +129,10 @@ struct ImplicitSettings {
   uint32_t parallel_grain_springs = 512;
   uint32_t parallel_grain_rows = 128;
   uint32_t cg_team_min_rows = 256;
+  // From cg_team_min_rows nodes on, Timed runs a step on the team or on the calling thread alone,
+  // whichever measured cheaper for sets of its size (team_choice.hpp); Always forms the team
+  // (tests that split every loop). The bits are the same either way.
+  TeamPolicy team_policy = TeamPolicy::Timed;
   // TwoLevel: rebuild the hierarchy when more than this fraction of the unknowns entered or left
   // the set since its build (otherwise reuse it stale); a topology change always rebuilds.
   double two_level_rebuild_fraction = 0.2;
@@ -149,6 +155,7 @@ struct ImplicitStats {
   double step_fraction = 1.0;     // last step: line-search fraction α of the Newton step taken
   uint64_t line_search_cuts = 0;  // steps that took α < 1
   uint64_t cg_iterations_total = 0;
+  uint64_t team_steps = 0;      // steps whose assembly and solve ran on the team of two
   uint32_t unknowns = 0;        // particles solved for, last step
   uint32_t springs = 0;         // springs assembled, last step
   uint64_t nonzeros = 0;        // scalar entries of the operator (stored or applied), last step
@@ -257,6 +264,7 @@ struct ImplicitCache {
   CgWork cg;
   std::vector<double> warm_dv;  // 3 per particle: the last Δv (mm/s), CG's first guess
   std::unique_ptr<PreconditionerState, PreconditionerStateDeleter> preconditioner;
+  TeamChoice team_choice;  // runtime only: which way recent steps of each size cost less
 
   // --- predictor ---
   bool predictor_valid = false;

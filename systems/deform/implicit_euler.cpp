@@ -13,6 +13,7 @@
 #include <optional>
 #include <utility>
 
+#include "engine/core/clock.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "engine/schedule/phased_team.hpp"
 #include "systems/deform/implicit.hpp"
@@ -296,18 +297,12 @@ void row_terms(const Membrane& m, double dt, ImplicitCache& cache, uint32_t ub, 
 
 // Two phases on the step's team: the springs, then the rows, each in an even number of equal
 // chunks (the team's two threads start from opposite ends).
-// Deflation's CG waits in every iteration while one thread solves the coarse system, so on the
-// active sets the drills step it lost to one thread: the capsulorhexis expert's frame mean was
-// 0.74–0.82× as fast on 2 threads as on 1 at every level 0–8 (`phaco-perf sweep`, session 37;
-// sets of up to 1,513 nodes at level 8). Below this many nodes its step keeps to the calling
-// thread; the results are the same bits either way (the team's sums do not depend on it). Above
-// it the team is not measured: no drill reaches it.
-constexpr uint32_t kDeflationTeamMinNodes = 4096;
-
-uint32_t team_min_nodes(const ImplicitSettings& settings) {
-  return settings.preconditioner == Preconditioner::Deflation
-             ? std::max(settings.cg_team_min_rows, kDeflationTeamMinNodes)
-             : settings.cg_team_min_rows;
+// Whether this step forms its team of two (ImplicitSettings::team_policy; team_choice.hpp).
+bool step_on_team(ImplicitCache& cache, uint32_t nodes) {
+  const ImplicitSettings& s = cache.settings;
+  if (worker_count() < 2 || nodes < s.cg_team_min_rows) return false;
+  if (s.team_policy == TeamPolicy::Always) return true;
+  return choose_team(cache.team_choice, nodes, {.min_nodes = s.cg_team_min_rows});
 }
 
 void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& team) {
@@ -358,8 +353,10 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
   // A team for the assembly and the solve, formed now: its worker wakes while this thread selects
   // and assembles (engine/schedule/phased_team.hpp). Let go before the solve if the solve is
   // Eigen's, whose parallel loops need the worker free.
+  const bool on_team = step_on_team(cache, static_cast<uint32_t>(nu));
+  const int64_t team_from = now_ns();
   std::optional<PhasedTeam> team;
-  team.emplace(nu >= team_min_nodes(cache.settings));
+  team.emplace(on_team);
   assemble(m, dt, cache, *team);
   const bool row_chunked = cache.settings.cg_operator == CgOperator::MatrixFree &&
                            implicit_detail::team_cg_preconditioner(cache.settings.preconditioner);
@@ -378,6 +375,14 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
   implicit_detail::solve_linear_system(cache, team ? &*team : nullptr);
   team.reset();
   cache.stats.cg_iterations_total += cache.stats.cg_iterations;
+  if (on_team) ++cache.stats.team_steps;
+  // The step's cost both ways, per node and iteration (two more for the assembly), for the next
+  // steps' choice. Only where there was a choice: a single thread or a small set times nothing.
+  if (cache.settings.team_policy == TeamPolicy::Timed && worker_count() >= 2)
+    record_team_step(
+        cache.team_choice, static_cast<uint32_t>(nu), on_team,
+        double(now_ns() - team_from) / (double(nu) * double(cache.stats.cg_iterations + 2)),
+        {.min_nodes = cache.settings.cg_team_min_rows});
 
   // Step 6. The linear solve is one Newton step of the incremental potential Φ (Gast et al. 2015);
   // at k·dt²/m ≈ 10⁷ a full step can overshoot where springs rotate or buckle, so take the largest

@@ -48,6 +48,7 @@ Outcome run(const std::string& preconditioner, int threads) {
   settings.parallel_min_unknowns = 0;
   settings.parallel_grain_unknowns = 8;
   settings.cg_team_min_rows = 0;  // a team of two for the assembly and the row-chunked CG
+  settings.team_policy = deform::TeamPolicy::Always;
   settings.parallel_grain_rows = 8;
   settings.parallel_grain_springs = 16;
   for (uint64_t f = 0; f < scene->scenario.frame_count(); ++f) step(*scene);
@@ -64,6 +65,10 @@ TEST(CapsulePhysics, EveryPreconditionerGivesTheSameStateHashOnOneAndTwoThreads)
     EXPECT_GT(one.summary["cg_iterations_total"].get<uint64_t>(), 0u);
     EXPECT_GT(one.summary["cg_iterations_per_step_mean"].get<double>(), 0.0);
     EXPECT_EQ(one.summary["divergences"], 0u);
+    // The row-chunked CGs (deflation's too) really ran on the team of two, and the hash held.
+    EXPECT_EQ(one.summary["team_steps"], 0u);
+    if (p == "jacobi" || p == "block_jacobi" || p == "deflation")
+      EXPECT_GT(two.summary["team_steps"].get<uint64_t>(), 0u);
   }
 }
 

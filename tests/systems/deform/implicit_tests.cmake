@@ -5,6 +5,7 @@ phaco_test(test_implicit
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit_active.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_implicit_predictor.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_team_choice.cpp
   LIBS phaco_sys_deform phaco_sys_springs phaco_sys_active_nodes phaco_eye TBB::tbb)
 # Not in unity batches (PHACO_UNITY_BUILD): its three files each define the frame step and helpers
 # of the same names at file scope, as the deform library itself is kept out.

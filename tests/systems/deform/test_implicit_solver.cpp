@@ -232,6 +232,7 @@ void thread_everything(ImplicitCache& cache) {
   cache.settings.parallel_min_unknowns = 0;
   cache.settings.parallel_grain_unknowns = 16;
   cache.settings.cg_team_min_rows = 0;
+  cache.settings.team_policy = deform::TeamPolicy::Always;
   cache.settings.parallel_grain_rows = 16;
   cache.settings.parallel_grain_springs = 32;
 }

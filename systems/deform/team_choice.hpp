@@ -1,0 +1,55 @@
+#pragma once
+// Whether the implicit step's team of two threads pays, decided by timing both ways (issue 17).
+//
+// The team (engine/schedule/phased_team.hpp) hands a phase from thread to thread several times
+// per CG iteration, so what it gains depends on where the two threads run, and on this 2-vCPU VM
+// that changed within minutes as the host moved the vCPUs: a core-to-core round trip of
+// 440–480 ns (cores apart), 112–117 ns (cores near) or 70–80 ns (two hardware threads of one
+// core), per perf/benchmarks/bench_engine BM_CoreRoundTrip. The capsulorhexis expert at level 6,
+// frame mean on 2 threads beside the haptic thread: the team 1.08–1.12× as fast as 1 thread with
+// the cores near, 0.7–0.8× with them apart (docs/implicit_and_active.md, "Session 40"). No fixed
+// size threshold is right in every placement, so each size class keeps its recent steps' costs
+// with and without the team, takes the cheaper, and tries the other now and then.
+//
+// The choice moves work between threads, never a result: the team's sums run in chunk order
+// whoever runs a chunk, so 1 and 2 threads give the same bits whichever way a step went.
+#include <array>
+#include <cstdint>
+
+namespace phaco::deform {
+
+struct TeamChoice {
+  // The last few steps' costs one way, per node and CG iteration (ns). The way's cost is their
+  // least: a step is only ever slowed by what else ran (the haptic thread, the host), never sped
+  // up, so the least of a few is the way's own cost, and a way whose cost rises loses its old
+  // low figures within a few steps.
+  struct Recent {
+    std::array<double, 8> ns{};
+    uint32_t steps = 0;  // recorded so far (the ring holds the last min(steps, 8))
+    double least() const;
+  };
+  struct SizeClass {
+    Recent alone, team;
+    uint32_t since_trial = 0;  // steps since the costlier way was last tried
+  };
+  // By ⌊log2 nodes⌋ − 8: 256–511 nodes, 512–1023, ..., the last class everything larger.
+  std::array<SizeClass, 8> classes{};
+};
+
+// Thresholds of the choice (team_choice.cpp says why each has its value).
+struct TeamChoiceRule {
+  uint32_t min_nodes = 256;     // below: the calling thread alone, untimed
+  uint32_t trial_steps = 4;     // steps each way before the cheaper is taken
+  uint32_t retrial_every = 32;  // then the costlier way once per this many steps
+};
+
+// Should a step over `nodes` nodes run on the team? false below rule.min_nodes.
+// Thread: the step's (the cache's owner).
+bool choose_team(TeamChoice& choice, uint32_t nodes, const TeamChoiceRule& rule = {});
+
+// The step's measured cost: wall time of its assembly and solve over nodes × (iterations + 2).
+// Thread: the step's.
+void record_team_step(TeamChoice& choice, uint32_t nodes, bool on_team, double ns_per_node_it,
+                      const TeamChoiceRule& rule = {});
+
+}  // namespace phaco::deform

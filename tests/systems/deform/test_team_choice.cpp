@@ -1,0 +1,103 @@
+// The implicit step's choice between its team of two and the calling thread alone
+// (systems/deform/team_choice.hpp): trials both ways, then the cheaper, and a retrial that lets a
+// change of costs (the host moving the cores) turn the choice.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include "systems/deform/team_choice.hpp"
+
+namespace phaco::deform {
+namespace {
+
+// Runs `steps` steps of `nodes` nodes whose cost is alone_ns or team_ns per node and iteration;
+// returns how many ran on the team.
+int run_steps(TeamChoice& choice, uint32_t nodes, int steps, double alone_ns, double team_ns,
+              const TeamChoiceRule& rule = {}) {
+  int on_team = 0;
+  for (int k = 0; k < steps; ++k) {
+    const bool team = choose_team(choice, nodes, rule);
+    on_team += team;
+    record_team_step(choice, nodes, team, team ? team_ns : alone_ns, rule);
+  }
+  return on_team;
+}
+
+TEST(TeamChoice, SmallSetsStayOnTheCallingThreadAndAreNotTimed) {
+  TeamChoice choice;
+  EXPECT_EQ(run_steps(choice, 255, 100, 10.0, 1.0), 0);
+  for (const auto& c : choice.classes) EXPECT_EQ(c.alone.steps + c.team.steps, 0u);
+}
+
+TEST(TeamChoice, TriesBothWaysAlternatelyBeforeChoosing) {
+  TeamChoice choice;
+  const TeamChoiceRule rule;
+  std::vector<bool> ways;
+  for (uint32_t k = 0; k < 2 * rule.trial_steps; ++k) {
+    const bool team = choose_team(choice, 1000, rule);
+    ways.push_back(team);
+    record_team_step(choice, 1000, team, 1.0, rule);
+  }
+  EXPECT_EQ(std::count(ways.begin(), ways.end(), true), int(rule.trial_steps));
+  for (size_t k = 1; k < ways.size(); ++k) EXPECT_NE(ways[k], ways[k - 1]) << k;
+}
+
+TEST(TeamChoice, TakesTheCheaperWayAndRetriesTheOtherNowAndThen) {
+  const TeamChoiceRule rule;
+  TeamChoice faster_team;
+  const int steps = 8 + 32 * 10;
+  // After the 4 + 4 trials: the cheaper every step but one in rule.retrial_every.
+  const int team_runs = run_steps(faster_team, 1000, steps, 1.0, 0.8, rule);
+  EXPECT_EQ(team_runs, 4 + (steps - 8) - (steps - 8) / int(rule.retrial_every));
+  TeamChoice slower_team;
+  EXPECT_EQ(run_steps(slower_team, 1000, steps, 1.0, 1.3, rule),
+            4 + (steps - 8) / int(rule.retrial_every));
+}
+
+TEST(TeamChoice, FollowsAChangeOfCostsBothWays) {
+  TeamChoice choice;
+  // The team costs 1.3× first (cores far apart), then 0.8× (the host moved them), then 1.3× again.
+  run_steps(choice, 2000, 200, 1.0, 1.3);
+  const int near = run_steps(choice, 2000, 400, 1.0, 0.8);
+  // The first retrial's low cost turns the choice (at most 32 steps in).
+  EXPECT_GT(near, 400 - 32 - 400 / 32) << "one retrial should find the cheaper team";
+  const int far_again = run_steps(choice, 2000, 100, 1.0, 1.3);
+  // The team keeps its old low costs until they leave its last 8: 8 steps, then retrials.
+  EXPECT_LE(far_again, 8 + 100 / 32) << "a costlier team is dropped within a few steps";
+}
+
+TEST(TeamChoice, PreemptedStepsDoNotTurnTheChoice) {
+  // Every third team step is preempted (the haptic thread took a core: 5× its cost); the team
+  // is still the cheaper way and stays chosen.
+  TeamChoice choice;
+  int on_team = 0, team_steps = 0;
+  for (int k = 0; k < 400; ++k) {
+    const bool team = choose_team(choice, 1000);
+    on_team += team;
+    const double cost = team ? (++team_steps % 3 == 0 ? 4.0 : 0.8) : 1.0;
+    record_team_step(choice, 1000, team, cost);
+  }
+  EXPECT_GT(on_team, 400 - 4 - 400 / 32 - 1);
+}
+
+TEST(TeamChoice, SizeClassesAreTimedApart) {
+  TeamChoice choice;
+  // Small sets: the team loses; large sets: it wins. Each class learns its own.
+  run_steps(choice, 300, 100, 1.0, 1.5);
+  run_steps(choice, 5000, 100, 1.0, 0.6);
+  EXPECT_LT(run_steps(choice, 300, 64, 1.0, 1.5), 4);
+  EXPECT_GT(run_steps(choice, 5000, 64, 1.0, 0.6), 60);
+}
+
+TEST(TeamChoice, ANonFiniteOrNegativeCostIsIgnored) {
+  TeamChoice choice;
+  record_team_step(choice, 1000, true, -1.0);
+  record_team_step(choice, 1000, true, std::numeric_limits<double>::infinity());
+  record_team_step(choice, 1000, false, std::numeric_limits<double>::quiet_NaN());
+  for (const auto& c : choice.classes) EXPECT_EQ(c.alone.steps + c.team.steps, 0u);
+}
+
+}  // namespace
+}  // namespace phaco::deform
