@@ -295,8 +295,6 @@ void row_terms(const Membrane& m, double dt, ImplicitCache& cache, uint32_t ub, 
   }
 }
 
-// Two phases on the step's team: the springs, then the rows, each in an even number of equal
-// chunks (the team's two threads start from opposite ends).
 // Whether this step forms its team of two (ImplicitSettings::team_policy; team_choice.hpp).
 bool step_on_team(ImplicitCache& cache, uint32_t nodes) {
   const ImplicitSettings& s = cache.settings;
@@ -305,6 +303,8 @@ bool step_on_team(ImplicitCache& cache, uint32_t nodes) {
   return choose_team(cache.team_choice, nodes, {.min_nodes = s.cg_team_min_rows});
 }
 
+// Two phases on the step's team: the springs, then the rows, each in an even number of equal
+// chunks (the team's two threads start from opposite ends).
 void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& team) {
   const uint32_t nu = static_cast<uint32_t>(cache.unknowns.particles.size());
   const uint32_t ns = static_cast<uint32_t>(cache.unknowns.springs.size());
