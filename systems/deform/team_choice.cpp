@@ -45,7 +45,8 @@ void record_team_step(TeamChoice& choice, uint32_t nodes, bool on_team, double n
   if (nodes < rule.min_nodes || !std::isfinite(ns_per_node_it) || ns_per_node_it < 0) return;
   TeamChoice::Recent& r =
       on_team ? size_class(choice, nodes).team : size_class(choice, nodes).alone;
-  r.ns[r.steps % r.ns.size()] = ns_per_node_it;
+  r.ns[r.next] = ns_per_node_it;
+  r.next = uint32_t((r.next + 1) % r.ns.size());
   if (r.steps < UINT32_MAX) ++r.steps;
 }
 

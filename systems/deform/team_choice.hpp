@@ -25,7 +25,8 @@ struct TeamChoice {
   // low figures within a few steps.
   struct Recent {
     std::array<double, 8> ns{};
-    uint32_t steps = 0;  // recorded so far (the ring holds the last min(steps, 8))
+    uint32_t steps = 0;  // recorded so far, up to UINT32_MAX (the ring holds min(steps, 8))
+    uint32_t next = 0;   // the ring's slot for the next step
     double least() const;
   };
   struct SizeClass {
@@ -36,7 +37,10 @@ struct TeamChoice {
   std::array<SizeClass, 8> classes{};
 };
 
-// Thresholds of the choice (team_choice.cpp says why each has its value).
+// Thresholds of the choice. 256 nodes is ImplicitSettings::cg_team_min_rows, below which a team
+// was never formed. 4 trials each way fill half of each ring before the least is trusted. One
+// retrial in 32 steps costs at most 1/32 of a step's excess (a team 30 % dearer: about 1 % of the
+// run) and turns the choice within 32 steps of the host moving the vCPUs (tests TeamChoice.*).
 struct TeamChoiceRule {
   uint32_t min_nodes = 256;     // below: the calling thread alone, untimed
   uint32_t trial_steps = 4;     // steps each way before the cheaper is taken
