@@ -86,6 +86,7 @@
 #include <string_view>
 #include <vector>
 
+#include "engine/schedule/alone_arena.hpp"
 #include "systems/deform/membrane.hpp"
 #include "systems/deform/team_choice.hpp"
 
@@ -265,6 +266,7 @@ struct ImplicitCache {
   std::vector<double> warm_dv;  // 3 per particle: the last Δv (mm/s), CG's first guess
   std::unique_ptr<PreconditionerState, PreconditionerStateDeleter> preconditioner;
   TeamChoice team_choice;  // runtime only: which way recent steps of each size cost less
+  AloneArena alone;        // runtime only: where a step not on the team runs its loops
 
   // --- predictor ---
   bool predictor_valid = false;

@@ -331,13 +331,12 @@ void assemble(const Membrane& m, double dt, ImplicitCache& cache, PhasedTeam& te
     implicit_detail::write_matrix_values(cache.pattern, sys.block, sys.matrix);
 }
 
-}  // namespace
-
-void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
+// Steps 2–6 on the unknowns step 1 selected, on the threads implicit_euler_step chose.
+void step_selected(Membrane& m, double dt, ImplicitCache& cache, bool set_changed, bool on_team,
+                   bool timed) {
   Particles& p = m.particles;
   const uint32_t n = p.slots.size();
-  fit_particle_arrays(n, cache);
-  if (select_unknowns(m, cache)) build_pattern(m.springs, cache);
+  if (set_changed) build_pattern(m.springs, cache);
   const UnknownSet& set = cache.unknowns;
   StepSystem& sys = cache.system;
   const size_t nu = set.particles.size();
@@ -350,10 +349,9 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
     cache.stats.cg_iterations = 0, cache.stats.cg_residual = 0.0, cache.stats.cg_converged = true;
     return;
   }
-  // A team for the assembly and the solve, formed now: its worker wakes while this thread selects
-  // and assembles (engine/schedule/phased_team.hpp). Let go before the solve if the solve is
-  // Eigen's, whose parallel loops need the worker free.
-  const bool on_team = step_on_team(cache, static_cast<uint32_t>(nu));
+  // A team for the assembly and the solve, formed now: its worker wakes while this thread
+  // assembles (engine/schedule/phased_team.hpp). Let go before the solve if the solve is Eigen's,
+  // whose parallel loops need the worker free.
   const int64_t team_from = now_ns();
   std::optional<PhasedTeam> team;
   team.emplace(on_team);
@@ -378,7 +376,7 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
   if (on_team) ++cache.stats.team_steps;
   // The step's cost both ways, per node and iteration (two more for the assembly), for the next
   // steps' choice. Only where there was a choice: a single thread or a small set times nothing.
-  if (cache.settings.team_policy == TeamPolicy::Timed && worker_count() >= 2)
+  if (timed)
     record_team_step(
         cache.team_choice, static_cast<uint32_t>(nu), on_team,
         double(now_ns() - team_from) / (double(nu) * double(cache.stats.cg_iterations + 2)),
@@ -420,6 +418,26 @@ void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
     m.forces.fy[i] = static_cast<float>(sys.force[3 * u + 1]);
     m.forces.fz[i] = static_cast<float>(sys.force[3 * u + 2]);
   }
+}
+
+}  // namespace
+
+void implicit_euler_step(Membrane& m, double dt, ImplicitCache& cache) {
+  fit_particle_arrays(m.particles.slots.size(), cache);
+  const bool set_changed = select_unknowns(m, cache);
+  const uint32_t nu = static_cast<uint32_t>(cache.unknowns.particles.size());
+  // The step's threads: its team of two where that measured cheaper (team_choice.hpp), else this
+  // thread alone for every loop of the step, not only CG's. The pattern's sort, the
+  // preconditioner's blocks and the line search's two potentials would each wake the worker for a
+  // few microseconds of work, and where the team lost, so do they (session 41: the 2-thread frame
+  // 2–3 % faster at levels 3 and 6, docs/implicit_and_active.md).
+  const bool two_threads = worker_count() >= 2;
+  const bool on_team = step_on_team(cache, nu);
+  const bool timed = two_threads && cache.settings.team_policy == TeamPolicy::Timed;
+  if (two_threads && !on_team)
+    cache.alone.run([&] { step_selected(m, dt, cache, set_changed, false, timed); });
+  else
+    step_selected(m, dt, cache, set_changed, on_team, timed);
 }
 
 }  // namespace phaco::deform

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/schedule/parallel.hpp"
+#include "tests/engine/schedule/order_sensitive.hpp"
 
 namespace phaco {
 namespace {
@@ -102,13 +103,7 @@ float reference_tree_sum(const std::vector<float>& x, uint32_t b, uint32_t e, ui
 
 TEST(ParallelReduceOrdered, FloatSumIsBitIdenticalForAnyThreadCount) {
   // Wide dynamic range so that any change of summation order changes the rounded result.
-  std::vector<float> x(100003);
-  uint32_t state = 12345;
-  for (float& v : x) {
-    state = state * 1664525u + 1013904223u;
-    const float mag = (state >> 28) == 0 ? 1.0e6f : 1.0e-3f;
-    v = mag * (static_cast<float>(state >> 8) / 16777216.0f - 0.3f);
-  }
+  const std::vector<float> x = test::order_sensitive_values(100003, 12345);
   const uint32_t n = static_cast<uint32_t>(x.size());
   auto sum_with = [&](int threads) {
     float result = 0;
@@ -130,9 +125,7 @@ TEST(ParallelReduceOrdered, FloatSumIsBitIdenticalForAnyThreadCount) {
   EXPECT_EQ(sum_with(4), one);
   EXPECT_EQ(std::bit_cast<uint32_t>(0.0f + reference_tree_sum(x, 0, n, 500)), one);
   // The data is order-sensitive: a plain left-to-right sum rounds differently.
-  float linear = 0;
-  for (float v : x) linear += v;
-  EXPECT_NE(std::bit_cast<uint32_t>(linear), one);
+  EXPECT_NE(std::bit_cast<uint32_t>(test::linear_sum(x)), one);
 }
 
 TEST(ParallelReduceOrdered, KeepsChunkOrderForNonCommutativeMerge) {
