@@ -19,6 +19,7 @@
 #include "engine/schedule/frame_graph.hpp"
 #include "engine/schedule/parallel.hpp"
 #include "engine/schedule/phased_team.hpp"
+#include "perf/cores.hpp"
 
 namespace phaco {
 namespace {
@@ -48,28 +49,6 @@ void BM_ExecutorFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_ExecutorFrame)->ArgsProduct({{2, 8, 32, 128}, {1, 2}})->Unit(benchmark::kMicrosecond);
 
-// The lowest and highest CPU the calling thread may run on (-1, -1 with fewer than two).
-std::pair<int, int> two_cpus() {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) != 0 || CPU_COUNT(&set) < 2)
-    return {-1, -1};
-  int low = -1, high = -1;
-  for (int c = 0; c < CPU_SETSIZE; ++c) {
-    if (!CPU_ISSET(c, &set)) continue;
-    if (low < 0) low = c;
-    high = c;
-  }
-  return {low, high};
-}
-
-void pin_to(int cpu) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(cpu, &set);
-  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
-}
-
 // One round trip of a cache line between two cores: the floor under every handoff of a team of
 // two threads (PhasedTeam's phase opening, a chunk claim). Session 40's 2-vCPU VM, as the host
 // moved its two vCPUs within minutes: 440–480 ns (apart), 112–117 ns (near), 70–80 ns (two
@@ -77,34 +56,14 @@ void pin_to(int cpu) {
 // BM_PhasedTeamPhases on 2 threads ran 1.4–1.8× as fast as on 1 in the first two and 0.67× in
 // the third (systems/deform/team_choice.hpp).
 void BM_CoreRoundTrip(benchmark::State& state) {
-  const auto [first, last] = two_cpus();
+  const auto [first, last] = perf::two_cpus();
   if (first < 0) {
     state.SkipWithError("needs two CPUs");
     return;
   }
-  std::atomic<int64_t> ball{0};
-  std::atomic<bool> done{false};
-  std::thread partner([&] {
-    pin_to(last);
-    for (int64_t seen = 1;; seen += 2) {
-      while (ball.load(std::memory_order_acquire) != seen)
-        if (done.load(std::memory_order_relaxed)) return;
-      ball.store(seen + 1, std::memory_order_release);
-    }
-  });
-  cpu_set_t before;
-  pthread_getaffinity_np(pthread_self(), sizeof(before), &before);
-  pin_to(first);
-  int64_t served = 1;
-  for (auto _ : state) {
-    ball.store(served, std::memory_order_release);
-    while (ball.load(std::memory_order_acquire) != served + 1) {
-    }
-    served += 2;
-  }
-  done.store(true, std::memory_order_relaxed);
-  partner.join();
-  pthread_setaffinity_np(pthread_self(), sizeof(before), &before);
+  const perf::PinnedScope pin(first);
+  perf::RoundTripPartner partner(last);
+  for (auto _ : state) partner.trip();
 }
 BENCHMARK(BM_CoreRoundTrip)->Unit(benchmark::kNanosecond)->UseRealTime();
 

@@ -1,13 +1,11 @@
 #include "perf/haptics/loop_measure.hpp"
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <chrono>
 #include <cmath>
 #include <thread>
 
 #include "engine/core/clock.hpp"
+#include "perf/cores.hpp"
 
 namespace phaco::perf {
 
@@ -19,14 +17,6 @@ void busy_tick(void* context, const TickInfo& info) {
   const int64_t until = info.wake_ns + work_ns;
   while (now_ns() < until) {
   }
-}
-
-void pin_current_thread(int cpu) {
-  if (cpu < 0) return;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(cpu, &set);
-  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);  // best effort: a load is a load
 }
 
 void busy_load(const std::atomic<bool>& stop) {
@@ -82,7 +72,7 @@ LoopMeasureRow measure_loop(const LoopMeasureCase& c) {
   std::thread load;
   if (c.load != LoopLoad::None) {
     load = std::thread([&] {
-      pin_current_thread(c.load_cpu);
+      const PinnedScope pin(c.load_cpu);  // best effort: a load is a load
       if (c.load == LoopLoad::Background && c.background)
         c.background(stop_load);
       else

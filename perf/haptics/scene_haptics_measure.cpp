@@ -1,7 +1,5 @@
 #include "perf/haptics/scene_haptics_measure.hpp"
 
-#include <pthread.h>
-#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +18,7 @@
 #include "procedures/haptics/realtime_run.hpp"
 // The haptic-thread allocation counter the tests use (global operator new, per marked thread);
 // linked into phaco-perf so the harness reports the same count.
+#include "perf/cores.hpp"
 #include "perf/haptics/counting_device.hpp"
 #include "tests/engine/haptics/alloc_counter.hpp"
 
@@ -44,26 +43,6 @@ double steal_ms() {
   if (!words) return -1;
   return v[7] * 1000.0 / double(sysconf(_SC_CLK_TCK));
 }
-
-// Pins the calling thread to one CPU for the scope; restores its previous set after.
-class PinnedScope {
- public:
-  explicit PinnedScope(int cpu) {
-    if (cpu < 0) return;
-    ok_ = pthread_getaffinity_np(pthread_self(), sizeof old_, &old_) == 0;
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(cpu, &set);
-    ok_ = ok_ && pthread_setaffinity_np(pthread_self(), sizeof set, &set) == 0;
-  }
-  ~PinnedScope() {
-    if (ok_) pthread_setaffinity_np(pthread_self(), sizeof old_, &old_);
-  }
-
- private:
-  cpu_set_t old_{};
-  bool ok_ = false;
-};
 
 }  // namespace
 

@@ -485,6 +485,61 @@ std::string why_missed_md(const std::vector<SweepRow>& rows, const std::vector<s
   return md.empty() ? "- Every issue-17 target that could be judged is met.\n" : md;
 }
 
+Placement placement_of(const SweepPointResult& r) {
+  const double a = r.round_trip_before_ns, b = r.round_trip_after_ns;
+  if (!std::isfinite(a) || !std::isfinite(b)) return Placement::Moved;
+  if (a < kNearRoundTripNs && b < kNearRoundTripNs) return Placement::Near;
+  if (a > kApartRoundTripNs && b > kApartRoundTripNs) return Placement::Apart;
+  return Placement::Moved;
+}
+
+std::string speedup_pairs_md(const std::vector<SweepRow>& rows, int max_level) {
+  static constexpr const char* kName[] = {"near", "apart", "moved"};
+  std::string table;
+  std::vector<double> by_placement[3];
+  for (int level = 0; level <= max_level; ++level) {
+    std::string cells;
+    for (int rep = 1;; ++rep) {
+      const std::string v = rep == 1 ? std::string("default") : repeat_variant(rep);
+      const SweepRow* one = find_row(rows, "capsulorhexis", level, 1, v);
+      const SweepRow* two = find_row(rows, "capsulorhexis", level, 2, v);
+      if (!one && !two) break;
+      const double s = speedup(one, two);
+      if (!std::isfinite(s)) continue;
+      const Placement p = placement_of(two->r);
+      by_placement[int(p)].push_back(s);
+      cells += (cells.empty() ? "" : ", ") + fmt("%.2f", s) + "× (" + kName[int(p)] + " " +
+               f("%.0f", two->r.round_trip_before_ns) + "/" +
+               f("%.0f", two->r.round_trip_after_ns) + " ns, " +
+               f("%.0f", physics_number(two->r, "capsule", "team_steps")) + " team)";
+    }
+    if (!cells.empty()) table += "| " + std::to_string(level) + " | " + cells + " |\n";
+  }
+  if (table.empty()) return "";
+  std::string summary;
+  for (int p = 0; p < 3; ++p) {
+    std::vector<double>& v = by_placement[p];
+    if (v.empty()) continue;
+    std::sort(v.begin(), v.end());
+    const double median =
+        v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    summary += (summary.empty() ? "" : "; ") + std::string(kName[p]) + ": " +
+               std::to_string(v.size()) + " pairs, median " + fmt("%.2f", median) + "× (" +
+               fmt("%.2f", v.front()) + "–" + fmt("%.2f", v.back()) + "×)";
+  }
+  return "**The speed-up pair by pair** (capsulorhexis expert, default methods): each pair's "
+         "1-thread mean over its 2-thread mean, with a cache line's round trip between the two "
+         "CPUs just before and just after the 2-thread point's frames (perf/cores.hpp; near: both "
+         "under " +
+         fmt("%.0f", kNearRoundTripNs) + " ns, apart: both over " + fmt("%.0f", kApartRoundTripNs) +
+         " ns, moved: in between or changed) and the steps that point took on its team of two "
+         "(systems/deform/team_choice.hpp). The host moves the two vCPUs within minutes, and a "
+         "team pays only where they are near (docs/implicit_and_active.md).\n\n"
+         "| level | pairs: speed-up (placement, round trip before/after, steps on the team) |\n"
+         "|---:|---|\n" +
+         table + "\nBy placement: " + summary + ".\n\n";
+}
+
 std::string frame_dispatch_md(const std::vector<SweepRow>& rows,
                               const std::vector<std::string>& drills) {
   std::string md;

@@ -101,4 +101,16 @@ std::string why_missed_md(const std::vector<SweepRow>& rows, const std::vector<s
 std::string frame_dispatch_md(const std::vector<SweepRow>& rows,
                               const std::vector<std::string>& drills);
 
+// Where the host put the vCPUs for a 2-thread point, from its round trips before and after the
+// frames (SweepPointResult): near when both were under kNearRoundTripNs, apart when both were over
+// kApartRoundTripNs, else moved (or not measured). Session 40's VM: 112–117 ns near, 440–480 apart.
+inline constexpr double kNearRoundTripNs = 250.0, kApartRoundTripNs = 300.0;
+enum class Placement { Near, Apart, Moved };
+Placement placement_of(const SweepPointResult& r);
+
+// The capsulorhexis speed-up pair by pair at each level: each pair's ratio, the steps the 2-thread
+// run took on its team of two, and where the vCPUs were; then the pairs' median speed-up by
+// placement (markdown; "" without pairs).
+std::string speedup_pairs_md(const std::vector<SweepRow>& rows, int max_level);
+
 }  // namespace phaco::perf

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include "engine/core/clock.hpp"
 #include "engine/core/error.hpp"
 #include "engine/haptics/scripted_device.hpp"
+#include "perf/cores.hpp"
 #include "perf/haptics/counting_device.hpp"
 #include "procedures/haptics/haptic_session.hpp"
 #include "procedures/scene/run.hpp"
@@ -21,6 +23,10 @@ namespace phaco::perf {
 namespace {
 
 namespace fs = std::filesystem;
+
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 // The haptic session beside the frames, but the scene keeps its scripted tracks: the device's
 // samples are drained (as a device-driven scene would) and ignored, so the state hash is the
@@ -136,6 +142,7 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
   reset_peak_rss();
 
   const uint64_t frames = s.frame_count();
+  r.round_trip_before_ns = core_round_trip_ns();  // ≈ 20 ms; no haptic thread yet
   step(*scene);  // the first model before the haptic thread starts, as run_realtime does
   const bool countable = probe && test::haptic_allocation_counting_available();
   if (session) {
@@ -173,6 +180,7 @@ SweepPointResult run_sweep_point(const SweepPointConfig& config) {
       r.period_bins.push_back({double(b.low_us), double(b.width_us), double(b.count)});
   }
   r.rss_peak_mb = status_mb("VmHWM");
+  r.round_trip_after_ns = core_round_trip_ns();
 
   r.frames = scene->frame;
   r.sim_s = scene->time_s;
@@ -269,7 +277,10 @@ nlohmann::json to_json(const SweepPointResult& r) {
           {"bytes_per_element", r.bytes_per_element},
           {"metrics", r.metrics},
           {"physics", r.physics},
-          {"state_hash", r.state_hash}};
+          {"state_hash", r.state_hash},
+          // null where not measured (JSON has no NaN)
+          {"core_round_trip_ns",
+           {finite_or_null(r.round_trip_before_ns), finite_or_null(r.round_trip_after_ns)}}};
 }
 
 SweepPointResult result_from_json(const nlohmann::json& j) {
@@ -312,6 +323,11 @@ SweepPointResult result_from_json(const nlohmann::json& j) {
   r.metrics = j.at("metrics");
   r.physics = j.at("physics");
   r.state_hash = j.at("state_hash");
+  if (const auto it = j.find("core_round_trip_ns");
+      it != j.end() && it->is_array() && it->size() == 2) {
+    if ((*it)[0].is_number()) r.round_trip_before_ns = (*it)[0];
+    if ((*it)[1].is_number()) r.round_trip_after_ns = (*it)[1];
+  }
   return r;
 }
 

@@ -8,10 +8,12 @@
 // overruns, allocations on the haptic thread and histogram while the frames run; resident memory
 // before the scene, after building it and at its peak while stepping, and bytes per element; the
 // drill's metrics (for accuracy against the reference point, perf/study_sweep.cpp), the physics
-// summaries, and the state hash that ties the figures to a reproducible run.
+// summaries, the state hash that ties the figures to a reproducible run, and the round trip
+// between the two CPUs before and after the frames.
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -71,6 +73,11 @@ struct SweepPointResult {
   nlohmann::json metrics = nlohmann::json::object();
   nlohmann::json physics = nlohmann::json::object();
   std::string state_hash;
+  // A cache line's round trip between the process's two CPUs just before the frames and just after
+  // them (perf/cores.hpp), ns; NaN on one CPU or in points saved before it was recorded. Where the
+  // host puts its vCPUs decides whether a team of two threads pays (docs/perf_sweep.md).
+  double round_trip_before_ns = std::numeric_limits<double>::quiet_NaN();
+  double round_trip_after_ns = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Runs the point in this process (what the child does).

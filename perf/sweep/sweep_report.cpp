@@ -332,6 +332,7 @@ std::string levels_md(const Section& s) {
       " runs of each, the repeats after every other point, thread order alternating) its "
       "speed-up is the mean of the paired ratios with its 95 % interval (Student's t), and the "
       "targets are judged on that mean; the frame columns are the first pair's.\n\n";
+  md += speedup_pairs_md(rows, max_level);
   return md;
 }
 

@@ -1,6 +1,7 @@
 // The issue-9 sweep's pieces: a point's result survives the trip through the child process's JSON,
 // the accuracy error is the largest relative difference of the drill's scored outcome, and a point
-// run with the haptic thread beside it is bit-identical to the plain run of the same scenario.
+// run with the haptic thread beside it is bit-identical to the plain run of the same scenario; the
+// speed-up pairs name where the vCPUs were, measured by a cache line's round trip.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -8,8 +9,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <thread>
 
 #include "engine/core/error.hpp"
+#include "perf/cores.hpp"
 #include "perf/sweep/sweep_data.hpp"
 #include "perf/sweep/sweep_levels.hpp"
 #include "perf/sweep/sweep_plan.hpp"
@@ -61,6 +65,11 @@ TEST(SweepPoint, ResultRoundTripsThroughJson) {
   EXPECT_DOUBLE_EQ(back.bytes_per_element, 180.5);
   EXPECT_EQ(back.state_hash, r.state_hash);
   EXPECT_DOUBLE_EQ(drill_elements(back), 112.0);  // tets left plus those the probe removed
+  EXPECT_TRUE(std::isnan(back.round_trip_before_ns)) << "not measured: null, read back as NaN";
+  r.round_trip_before_ns = 131.5, r.round_trip_after_ns = 462.0;
+  const SweepPointResult measured = result_from_json(nlohmann::json::parse(to_json(r).dump()));
+  EXPECT_DOUBLE_EQ(measured.round_trip_before_ns, 131.5);
+  EXPECT_DOUBLE_EQ(measured.round_trip_after_ns, 462.0);
 }
 
 TEST(SweepAccuracy, LargestRelativeDifferenceOfTheScoredOutcome) {
@@ -186,6 +195,63 @@ TEST(SweepSpeedup, RepeatsArePlannedLastAndAveragedPairByPair) {
   EXPECT_NEAR(figs[0].speedup_hi - 1.5, 4.303 * 0.3 / std::sqrt(3.0), 1e-9);
   EXPECT_NEAR(figs[0].mean_1, 1.2, 1e-12);  // the frame columns are the first pair's
   EXPECT_NE(speedup_text(figs[0]).find("], 3"), std::string::npos) << speedup_text(figs[0]);
+}
+
+// Each pair is listed with where the 2-thread point's vCPUs were, and the pairs' median speed-up is
+// given per placement.
+TEST(SweepSpeedup, PairsAreListedWithWhereTheVcpusWere) {
+  std::vector<SweepRow> rows;
+  auto add = [&](const std::string& variant, int threads, double mean_ms, double before,
+                 double after, double team) {
+    SweepRow row;
+    row.r = with_metrics("capsulorhexis", {{"score", 90.0}});
+    row.r.config.level = 6, row.r.config.threads = threads, row.r.config.variant = variant;
+    row.r.frame.mean_ms = mean_ms;
+    row.r.round_trip_before_ns = before, row.r.round_trip_after_ns = after;
+    row.r.physics["capsule"] = {{"team_steps", team}};
+    rows.push_back(row);
+  };
+  const double kNaN = std::numeric_limits<double>::quiet_NaN();
+  add("default", 1, 1.10, 130, 135, 0), add("default", 2, 1.00, 120, 140, 692);      // near: 1.10
+  add("repeat 2", 2, 1.00, 450, 470, 37), add("repeat 2", 1, 0.97, 455, 460, 0);     // apart: 0.97
+  add("repeat 3", 1, 1.20, 130, 460, 0), add("repeat 3", 2, 1.00, 130, 460, 400);    // moved: 1.20
+  add("repeat 4", 1, 0.99, 440, 450, 0), add("repeat 4", 2, 1.00, 440, 450, 40);     // apart: 0.99
+  add("repeat 5", 1, 1.00, kNaN, kNaN, 0), add("repeat 5", 2, 1.00, kNaN, kNaN, 9);  // unknown
+  EXPECT_EQ(placement_of(rows[1].r), Placement::Near);
+  EXPECT_EQ(placement_of(rows[2].r), Placement::Apart);
+  EXPECT_EQ(placement_of(rows[5].r), Placement::Moved);
+  EXPECT_EQ(placement_of(rows[9].r), Placement::Moved) << "not measured";
+  const std::string md = speedup_pairs_md(rows, 8);
+  EXPECT_NE(md.find("| 6 | 1.10× (near 120/140 ns, 692 team), 0.97× (apart 450/470 ns, 37 team)"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("near: 1 pairs, median 1.10×"), std::string::npos) << md;
+  EXPECT_NE(md.find("apart: 2 pairs, median 0.98× (0.97–0.99×)"), std::string::npos) << md;
+  EXPECT_NE(md.find("moved: 2 pairs"), std::string::npos) << md;
+  EXPECT_EQ(speedup_pairs_md({}, 8), "");
+}
+
+// A cache line's round trip: a positive figure between two CPUs, none where the thread may run on
+// one only.
+TEST(Cores, RoundTripIsMeasuredBetweenTwoCpusOnly) {
+  const int first = two_cpus().first;
+  if (first < 0) {  // this machine gives the test one CPU
+    EXPECT_TRUE(std::isnan(core_round_trip_ns(3, 1000)));
+    return;
+  }
+  const double ns = core_round_trip_ns(3, 1000);
+  EXPECT_TRUE(std::isfinite(ns));
+  EXPECT_GT(ns, 1.0);
+  EXPECT_LT(ns, 1e6);
+  std::thread([first] {
+    {
+      const PinnedScope one(first);
+      ASSERT_TRUE(one.pinned());
+      EXPECT_EQ(two_cpus().first, -1);
+      EXPECT_TRUE(std::isnan(core_round_trip_ns(3, 1000)));
+    }
+    EXPECT_EQ(two_cpus().first, first) << "the scope gave the thread its CPUs back";
+  }).join();
 }
 
 }  // namespace
