@@ -15,10 +15,10 @@
 #include "engine/haptics/scripted_device.hpp"
 #include "engine/haptics/udp_bridge.hpp"
 #include "engine/io/track.hpp"
+#include "perf/cores.hpp"
 #include "procedures/haptics/realtime_run.hpp"
 // The haptic-thread allocation counter the tests use (global operator new, per marked thread);
 // linked into phaco-perf so the harness reports the same count.
-#include "perf/cores.hpp"
 #include "perf/haptics/counting_device.hpp"
 #include "tests/engine/haptics/alloc_counter.hpp"
 

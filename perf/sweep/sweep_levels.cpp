@@ -532,7 +532,8 @@ std::string speedup_pairs_md(const std::vector<SweepRow>& rows, int max_level) {
          "CPUs just before and just after the 2-thread point's frames (perf/cores.hpp; near: both "
          "under " +
          fmt("%.0f", kNearRoundTripNs) + " ns, apart: both over " + fmt("%.0f", kApartRoundTripNs) +
-         " ns, moved: in between or changed) and the steps that point took on its team of two "
+         " ns, moved: in between, changed, or not measured) and the steps that point took on its "
+         "team of two "
          "(systems/deform/team_choice.hpp). The host moves the two vCPUs within minutes, and a "
          "team pays only where they are near (docs/implicit_and_active.md).\n\n"
          "| level | pairs: speed-up (placement, round trip before/after, steps on the team) |\n"
