@@ -119,8 +119,9 @@ studies:
       default methods never diverge and stay within their accuracy bounds against the run's own
       finest level. --speedup-reps N (default 5, quick 1): the capsulorhexis points on 1 and 2
       threads run N times in all, the repeats last, so that the 2-thread speed-up is the mean of
-      N paired runs with its 95 % interval (repeats must give the same state hash). About 25
-      minutes (quick about 1).
+      N paired runs with its 95 % interval (repeats must give the same state hash), listed pair
+      by pair with where the vCPUs were: each point measures a cache line's round trip between
+      its two CPUs before and after its frames. About 25 minutes (quick about 1).
       --replot redraws the section and charts from DIR/results/sweep_points.json without
       measuring again (the figures stay those of the run that measured them).
       --reference makes DIR/results/sweep_reference.json instead: per drill, one run off the
