@@ -31,10 +31,19 @@ bool choose_team(TeamChoice& choice, uint32_t nodes, const TeamChoiceRule& rule)
   if (c.alone.steps < rule.trial_steps || c.team.steps < rule.trial_steps)
     return c.team.steps < c.alone.steps;
   const bool team_cheaper = c.team.least() < c.alone.least();
-  // Now and then the costlier way: the host may have moved the cores (team_choice.hpp), and a
-  // cost last measured minutes ago says nothing of now.
-  if (++c.since_trial >= rule.retrial_every) {
+  // A turned choice: the costs moved (the host moved the vCPUs), so look again soon.
+  if (c.retrial_interval == 0 || team_cheaper != c.team_was_cheaper) {
+    c.retrial_interval = rule.retrial_every;
     c.since_trial = 0;
+  }
+  c.team_was_cheaper = team_cheaper;
+  // Now and then the costlier way: the host may have moved the cores (team_choice.hpp), and a
+  // cost last measured minutes ago says nothing of now. While retrials keep confirming the
+  // choice, they thin out (TeamChoiceRule).
+  if (++c.since_trial >= c.retrial_interval) {
+    c.since_trial = 0;
+    c.retrial_interval =
+        std::min(2 * c.retrial_interval, std::max(rule.retrial_most, rule.retrial_every));
     return !team_cheaper;
   }
   return team_cheaper;

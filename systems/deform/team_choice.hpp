@@ -31,20 +31,28 @@ struct TeamChoice {
   };
   struct SizeClass {
     Recent alone, team;
-    uint32_t since_trial = 0;  // steps since the costlier way was last tried
+    uint32_t since_trial = 0;       // steps since the costlier way was last tried
+    uint32_t retrial_interval = 0;  // steps between retrials now (0: rule.retrial_every)
+    bool team_was_cheaper = false;  // the way taken at the last choice after the trials
   };
   // By ⌊log2 nodes⌋ − 8: 256–511 nodes, 512–1023, ..., the last class everything larger.
   std::array<SizeClass, 8> classes{};
 };
 
 // Thresholds of the choice. 256 nodes is ImplicitSettings::cg_team_min_rows, below which a team
-// was never formed. 4 trials each way fill half of each ring before the least is trusted. One
-// retrial in 32 steps costs at most 1/32 of a step's excess (a team 30 % dearer: about 1 % of the
-// run) and turns the choice within 32 steps of the host moving the vCPUs (tests TeamChoice.*).
+// was never formed. 4 trials each way fill half of each ring before the least is trusted. Then
+// the costlier way is retried after 32 steps, and each retrial that leaves the choice as it was
+// doubles the wait, up to 256 steps; a turned choice brings the wait back to 32. With the vCPUs
+// apart, a retrial every 32 steps put 38–71 (once 199) of the level-0 expert's steps on a team
+// that lost (2 threads 0.94× and 0.95× as fast as 1: medians of two batches of 8 triples); with
+// the waits doubling, 14–38 (twice 79 and 110), and 0.99× and 1.00×. Neutral at level 6, where
+// session 41 had tried it (docs/implicit_and_active.md, "Session 43"). A move of the vCPUs is
+// still followed within 256 steps (tests TeamChoice.*).
 struct TeamChoiceRule {
   uint32_t min_nodes = 256;     // below: the calling thread alone, untimed
   uint32_t trial_steps = 4;     // steps each way before the cheaper is taken
-  uint32_t retrial_every = 32;  // then the costlier way once per this many steps
+  uint32_t retrial_every = 32;  // then the costlier way after this many steps ...
+  uint32_t retrial_most = 256;  // ... the wait doubling while the choice holds, up to this
 };
 
 // Should a step over `nodes` nodes run on the team? false below rule.min_nodes.

@@ -46,26 +46,64 @@ TEST(TeamChoice, TriesBothWaysAlternatelyBeforeChoosing) {
 
 TEST(TeamChoice, TakesTheCheaperWayAndRetriesTheOtherNowAndThen) {
   const TeamChoiceRule rule;
+  // After the 4 + 4 trials, 1,000 steps: the costlier way is retried after 32, 64, 128 and then
+  // every 256 steps (at 32, 96, 224, 480, 736 and 992), the cheaper way every other step.
+  const int after_trials = 1000, retrials = 6;
   TeamChoice faster_team;
-  const int steps = 8 + 32 * 10;
-  // After the 4 + 4 trials: the cheaper every step but one in rule.retrial_every.
-  const int team_runs = run_steps(faster_team, 1000, steps, 1.0, 0.8, rule);
-  EXPECT_EQ(team_runs, 4 + (steps - 8) - (steps - 8) / int(rule.retrial_every));
+  EXPECT_EQ(run_steps(faster_team, 1000, 8 + after_trials, 1.0, 0.8, rule),
+            4 + after_trials - retrials);
   TeamChoice slower_team;
-  EXPECT_EQ(run_steps(slower_team, 1000, steps, 1.0, 1.3, rule),
-            4 + (steps - 8) / int(rule.retrial_every));
+  EXPECT_EQ(run_steps(slower_team, 1000, 8 + after_trials, 1.0, 1.3, rule), 4 + retrials);
+}
+
+TEST(TeamChoice, RetrialsThinOutWhileTheChoiceHolds) {
+  const TeamChoiceRule rule;
+  TeamChoice choice;
+  run_steps(choice, 1000, 2 * int(rule.trial_steps), 1.0, 1.3, rule);
+  // The team stays dearer: the waits between its retrials double up to rule.retrial_most.
+  std::vector<int> retrial_at;
+  for (int k = 1; k <= 1500; ++k) {
+    const bool team = choose_team(choice, 1000, rule);
+    if (team) retrial_at.push_back(k);
+    record_team_step(choice, 1000, team, team ? 1.3 : 1.0, rule);
+  }
+  const std::vector<int> expected = {32, 96, 224, 480, 736, 992, 1248};
+  EXPECT_EQ(retrial_at, expected);
 }
 
 TEST(TeamChoice, FollowsAChangeOfCostsBothWays) {
+  const TeamChoiceRule rule;
   TeamChoice choice;
-  // The team costs 1.3× first (cores far apart), then 0.8× (the host moved them), then 1.3× again.
-  run_steps(choice, 2000, 200, 1.0, 1.3);
+  // The team costs 1.3× first (cores far apart) for long enough that the retrials are at their
+  // widest, then 0.8× (the host moved them), then 1.3× again.
+  run_steps(choice, 2000, 1200, 1.0, 1.3);
+  ASSERT_EQ(choice.classes[2].retrial_interval, rule.retrial_most);
   const int near = run_steps(choice, 2000, 400, 1.0, 0.8);
-  // The first retrial's low cost turns the choice (at most 32 steps in).
-  EXPECT_GT(near, 400 - 32 - 400 / 32) << "one retrial should find the cheaper team";
+  // The next retrial's low cost turns the choice (at most retrial_most steps in); after the turn
+  // the calling thread alone is retried at the short wait again, then less and less often.
+  EXPECT_GE(near, 400 - int(rule.retrial_most) - 4) << "one retrial should find the cheaper team";
+  EXPECT_LE(near, 400 - 2);
   const int far_again = run_steps(choice, 2000, 100, 1.0, 1.3);
   // The team keeps its old low costs until they leave its last 8: 8 steps, then retrials.
   EXPECT_LE(far_again, 8 + 100 / 32) << "a costlier team is dropped within a few steps";
+}
+
+TEST(TeamChoice, ATurnedChoiceBringsTheShortWaitBack) {
+  const TeamChoiceRule rule;
+  TeamChoice choice;
+  run_steps(choice, 1000, 1200, 1.0, 1.3);  // waits at their widest
+  // The team becomes cheaper: the retrial that finds it turns the choice, and the calling
+  // thread's own retrial comes rule.retrial_every steps after that, not retrial_most.
+  int turned_at = -1, alone_retrial_at = -1;
+  for (int k = 1; k <= 600 && alone_retrial_at < 0; ++k) {
+    const bool team = choose_team(choice, 1000, rule);
+    record_team_step(choice, 1000, team, team ? 0.8 : 1.0, rule);
+    if (team && turned_at < 0) turned_at = k;
+    if (!team && turned_at >= 0) alone_retrial_at = k;
+  }
+  ASSERT_GT(turned_at, 0);
+  EXPECT_LE(turned_at, int(rule.retrial_most));
+  EXPECT_EQ(alone_retrial_at - turned_at, int(rule.retrial_every));
 }
 
 TEST(TeamChoice, PreemptedStepsDoNotTurnTheChoice) {
