@@ -80,6 +80,8 @@ std::vector<LevelFigures> level_figures(const std::vector<SweepRow>& rows, const
     g.cg_per_step = cg_iterations_per_step(r);
     g.refresh_ms_mean = physics_number(r, "capsule_cutting", "physics_refresh_ms_mean");
     g.refresh_ms_max = physics_number(r, "capsule_cutting", "physics_refresh_ms_max");
+    g.refresh_springs = physics_number(r, "capsule_cutting", "physics_refresh_springs_mean");
+    g.refresh_ms_per_spring = g.refresh_springs > 0 ? g.refresh_ms_mean / g.refresh_springs : kNaN;
     g.cut_edit_ms_max = physics_number(r, "capsule_cutting", "edit_ms_max");
     g.cornea_cut_max_ms = system_cost(r, "cornea_cut", &CostSummary::max_ms);
     g.p50_1 = a ? a->r.frame.p50_ms : kNaN, g.p99_1 = a ? a->r.frame.p99_ms : kNaN;
@@ -121,17 +123,18 @@ std::string level_tables_md(const std::vector<SweepRow>& rows,
     const bool rhexis = drill == "capsulorhexis", incision = drill == "corneal_incision";
     md += "**" + drill + "**, default methods (error: 1 thread, against the reference):\n\n";
     md += "| level | " + std::string(drill_elements_name(drill)) + " |" +
-          (rhexis ? " CG iterations per stepped frame | physics refresh per cut, mean / max (ms) |"
+          (rhexis ? " CG iterations per stepped frame | physics refresh per cut, mean / max (µs) | "
+                    "springs it patched, mean |"
                   : "") +
           (incision ? " cornea_cut worst frame (ms) |" : "") +
           " frame p50 / p99 / max, 1 thread (ms) | frame p50 / p99 / max, 2 threads (ms) | "
           "speed-up of the mean [95 %], pairs | error % |\n|---:|---:|" +
-          (rhexis ? "---:|---|" : "") + (incision ? "---:|" : "") + "---|---|---:|---:|\n";
+          (rhexis ? "---:|---|---:|" : "") + (incision ? "---:|" : "") + "---|---|---:|---:|\n";
     for (const auto& g : figs) {
       md += "| " + std::to_string(g.level) + " | " + fmt("%.0f", g.elements) + " | ";
       if (rhexis)
-        md += f("%.1f", g.cg_per_step) + " | " + f("%.1f", g.refresh_ms_mean) + " / " +
-              f("%.1f", g.refresh_ms_max) + " | ";
+        md += f("%.1f", g.cg_per_step) + " | " + f("%.1f", 1e3 * g.refresh_ms_mean) + " / " +
+              f("%.0f", 1e3 * g.refresh_ms_max) + " | " + f("%.1f", g.refresh_springs) + " | ";
       if (incision) md += f("%.2f", g.cornea_cut_max_ms) + " | ";
       md += f("%.3f", g.p50_1) + " / " + f("%.2f", g.p99_1) + " / " + f("%.1f", g.max_1) + " | " +
             f("%.3f", g.p50_2) + " / " + f("%.2f", g.p99_2) + " / " + f("%.1f", g.max_2) + " | " +
@@ -420,10 +423,22 @@ std::string why_missed_md(const std::vector<SweepRow>& rows, const std::vector<s
     if (rf.ok && rf.slope > 0.25) {
       const LevelFigures& hi = figs.back();
       md += "- **Physics refresh per cut** grows as elements^" + fmt("%.2f", rf.slope) + ": mean " +
-            f("%.1f", hi.refresh_ms_mean) + " ms, max " + f("%.1f", hi.refresh_ms_max) +
-            " ms at level " + std::to_string(hi.level) + " (" + fmt("%.0f", hi.elements) +
+            f("%.1f", 1e3 * hi.refresh_ms_mean) + " µs, max " + f("%.0f", 1e3 * hi.refresh_ms_max) +
+            " µs at level " + std::to_string(hi.level) + " (" + fmt("%.0f", hi.elements) +
             " capsule vertices), against a worst cut edit of " + f("%.2f", hi.cut_edit_ms_max) +
-            " ms there.\n";
+            " ms there.";
+      // What the refresh touches: a finer mesh's tear crosses more springs per frame, and the
+      // refresh patches each (docs/cutting_and_tearing.md).
+      const PowerFit springs = slope_over_levels(figs, &LevelFigures::refresh_springs, 0, 8);
+      const PowerFit per_spring =
+          slope_over_levels(figs, &LevelFigures::refresh_ms_per_spring, 0, 8);
+      if (springs.ok && per_spring.ok)
+        md += " The springs a refresh patches grow as elements^" + fmt("%.2f", springs.slope) +
+              " (" + f("%.1f", figs.front().refresh_springs) + " at level " +
+              std::to_string(figs.front().level) + ", " + f("%.1f", hi.refresh_springs) +
+              " at level " + std::to_string(hi.level) +
+              "), its cost per patched spring as elements^" + fmt("%.2f", per_spring.slope) + ".";
+      md += "\n";
     }
     std::string low;
     for (const auto& g : figs)

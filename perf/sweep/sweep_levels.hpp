@@ -24,8 +24,10 @@ struct LevelFigures {
   double elements = 0;  // the drill's own body (sweep_data.hpp)
   double cg_per_step = 0;
   double refresh_ms_mean = 0, refresh_ms_max = 0;  // capsule physics refresh per cut
-  double cut_edit_ms_max = 0;                      // the capsule cut's edit alone, worst
-  double cornea_cut_max_ms = 0;                    // the cornea_cut system's worst frame
+  double refresh_springs = 0;        // springs a refresh patched (added + removed), mean per cut
+  double refresh_ms_per_spring = 0;  // refresh_ms_mean / refresh_springs
+  double cut_edit_ms_max = 0;        // the capsule cut's edit alone, worst
+  double cornea_cut_max_ms = 0;      // the cornea_cut system's worst frame
   double p50_1 = 0, p99_1 = 0, max_1 = 0, mean_1 = 0;
   double p50_2 = 0, p99_2 = 0, max_2 = 0, mean_2 = 0;
   // The 2-thread speed-up of the mean frame: the mean over the level's paired runs (1-thread mean

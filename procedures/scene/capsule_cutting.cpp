@@ -428,6 +428,8 @@ SystemDesc capsule_cut_system(Scene& scene) {
           }
           return;
         }
+        cc.refresh_springs_total +=
+            cc.topology.added_springs.size() + cc.topology.removed_springs.size();
         const auto t1 = std::chrono::steady_clock::now();
         add_sources(cc, p, ctx.frame);
         refresh_physics(m, sp, cc.log);
@@ -466,6 +468,9 @@ nlohmann::json capsule_cutting_summary(Scene& scene) {
       {"physics_refresh_ms_mean",
        cc->topology_changes ? cc->refresh_ms_total / double(cc->topology_changes) : 0.0},
       {"physics_refresh_ms_max", cc->refresh_ms_max},
+      {"physics_refresh_springs_mean",
+       cc->topology_changes ? double(cc->refresh_springs_total) / double(cc->topology_changes)
+                            : 0.0},
       {"compactions", cc->compactions},
       {"compaction_ms_total", cc->compaction_ms_total},
       {"temporary_grasp_vertices", cc->temporary_vertices},

@@ -90,6 +90,9 @@ struct CapsuleCutting {
   cut::EditLog log;  // this frame's edits (cleared each frame)
   uint64_t frames = 0, cut_segments = 0, topology_changes = 0;
   double refresh_ms_total = 0.0, refresh_ms_max = 0.0;  // physics patch after changes
+  // What the refreshes patched: springs added plus springs removed, summed over topology changes
+  // (the touched region a refresh's cost should follow, issue 17).
+  uint64_t refresh_springs_total = 0;
   // Deferred compaction: due when tail + tombstones exceed max(compact_min_springs,
   // compact_fraction × live springs); done in the next frame without topology change.
   double compact_fraction = 0.5;

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "engine/core/error.hpp"
+#include "perf/report.hpp"
 #include "perf/sweep/sweep_levels.hpp"
 #include "perf/sweep/sweep_mechanics.hpp"
 #include "perf/sweep/sweep_reference.hpp"
@@ -218,6 +219,53 @@ TEST(SweepLevels, RefreshSlopeIsFittedOverTheChosenLevels) {
   EXPECT_GT(all.slope, 0.6);
   // Levels without the figure (a drill without cuts) give no fit, not a slope of 0.
   EXPECT_FALSE(slope_over_levels(figs, &LevelFigures::cornea_cut_max_ms, 0, 8).ok);
+}
+
+// The refresh per cut against what it patched: a finer mesh's tear crosses more springs, so the
+// per-cut figure can grow while each patched spring costs the same. The sweep reads the springs
+// per refresh from the run report and says both slopes where the per-cut target is missed.
+TEST(SweepLevels, RefreshIsAlsoReadPerPatchedSpring) {
+  std::vector<SweepRow> rows;
+  for (int l = 0; l <= 8; ++l) {
+    SweepRow r = row_of("capsulorhexis", l, 1, {});
+    r.elements = 1000.0 * std::pow(2.0, l);
+    const double springs = 2.0 * std::pow(r.elements, 0.4);  // per refresh
+    const double ms_per_spring = 1e-4 * std::pow(r.elements, 0.05);
+    r.r.physics["capsule_cutting"] = {{"physics_refresh_ms_mean", ms_per_spring * springs},
+                                      {"physics_refresh_ms_max", 1e-3 * springs},
+                                      {"physics_refresh_springs_mean", springs}};
+    rows.push_back(r);
+  }
+  // A point of an older run, without the count: no figure per spring, not 0.
+  SweepRow old = row_of("capsulorhexis", 9, 1, {});
+  old.elements = 1e6;
+  old.r.physics["capsule_cutting"] = {{"physics_refresh_ms_mean", 0.5}};
+  rows.push_back(old);
+  const auto figs = level_figures(rows, "capsulorhexis", 9);
+  ASSERT_EQ(figs.size(), 10u);
+  EXPECT_NEAR(figs[3].refresh_ms_per_spring, 1e-4 * std::pow(8000.0, 0.05), 1e-12);
+  EXPECT_TRUE(std::isnan(figs[9].refresh_ms_per_spring));
+  const PowerFit per_cut = slope_over_levels(figs, &LevelFigures::refresh_ms_mean, 0, 8);
+  const PowerFit per_spring = slope_over_levels(figs, &LevelFigures::refresh_ms_per_spring, 0, 8);
+  ASSERT_TRUE(per_cut.ok && per_spring.ok);
+  EXPECT_NEAR(per_cut.slope, 0.45, 1e-9);
+  EXPECT_NEAR(per_spring.slope, 0.05, 1e-9);
+  // The table gives the refresh in µs and the springs it patched.
+  const std::string table = level_tables_md(rows, {"capsulorhexis"}, 8);
+  EXPECT_NE(table.find("physics refresh per cut, mean / max (µs) | springs it patched, mean |"),
+            std::string::npos)
+      << table;
+  const double springs0 = 2.0 * std::pow(1000.0, 0.4);  // 31.7 at level 0
+  const double us0 = 0.1 * std::pow(1000.0, 0.05) * springs0;
+  EXPECT_NE(table.find(fmt("| %.1f / ", us0) + fmt("%.0f | ", springs0) + fmt("%.1f |", springs0)),
+            std::string::npos)
+      << table;
+  // The missed per-cut target is explained by the two slopes.
+  const std::string why = why_missed_md(rows, {"capsulorhexis"}, 8, {});
+  EXPECT_NE(why.find("grows as elements^0.45"), std::string::npos) << why;
+  EXPECT_NE(why.find("The springs a refresh patches grow as elements^0.40"), std::string::npos)
+      << why;
+  EXPECT_NE(why.find("its cost per patched spring as elements^0.05"), std::string::npos) << why;
 }
 
 TEST(SweepLevels, TheParetoReadingSaysWhetherTheDefaultIsOnTheFront) {
