@@ -33,7 +33,7 @@ struct TeamChoice {
     Recent alone, team;
     uint32_t since_trial = 0;       // steps since the costlier way was last tried
     uint32_t retrial_interval = 0;  // steps between retrials now (0: rule.retrial_every)
-    bool team_was_cheaper = false;  // the way taken at the last choice after the trials
+    bool team_was_cheaper = false;  // whether the team was the cheaper way at the last choice
   };
   // By ⌊log2 nodes⌋ − 8: 256–511 nodes, 512–1023, ..., the last class everything larger.
   std::array<SizeClass, 8> classes{};
