@@ -43,11 +43,11 @@ struct TeamChoice {
 // was never formed. 4 trials each way fill half of each ring before the least is trusted. Then
 // the costlier way is retried after 32 steps, and each retrial that leaves the choice as it was
 // doubles the wait, up to 256 steps; a turned choice brings the wait back to 32. With the vCPUs
-// apart, a retrial every 32 steps put 38–71 (once 199) of the level-0 expert's steps on a team
-// that lost (2 threads 0.94× and 0.95× as fast as 1: medians of two batches of 8 triples); with
-// the waits doubling, 14–38 (twice 79 and 110), and 0.99× and 1.00×. Neutral at level 6, where
-// session 41 had tried it (docs/implicit_and_active.md, "Session 43"). A move of the vCPUs is
-// still followed within 256 steps (tests TeamChoice.*).
+// apart, a retrial every 32 steps put 38–71 (once 181, once 199) of the level-0 expert's steps
+// on a team that lost: 2 threads 0.93× as fast as 1 (median of 11 triples); with the waits
+// doubling, 14–38 (once 79, once 110) and 0.99×. Neutral at level 6, where session 41 had tried
+// it (docs/implicit_and_active.md, "Session 43"). A move of the vCPUs is still followed within
+// 256 steps (tests TeamChoice.*).
 struct TeamChoiceRule {
   uint32_t min_nodes = 256;     // below: the calling thread alone, untimed
   uint32_t trial_steps = 4;     // steps each way before the cheaper is taken
