@@ -106,22 +106,23 @@ studies:
       Issues 9 and 17, the whole trainer under load: each drill's scripted expert run to its end
       at every resolution level 0..L (default 8: 256k capsule vertices, 1.6M lens tets; quick
       0..3), on 1 and 2 threads, each point in a process of its own with the 1 kHz haptic thread
-      beside it; and each method alternative of the scene (integrators, stiffness, layout, active
-      set, spring law; broadphase, narrowphase, lens model) at levels 1, 3, 5 (quick 1). Records
-      frame and per-system p50/p99/max, CG iterations per stepped frame, physics refresh per cut,
-      the cornea's worst cut frame, the 2-thread speed-up per level, haptic period and overruns,
-      memory, and accuracy against the converged reference in DIR/results/sweep_reference.json
-      (else the source tree's perf/results; falls back, labelled "missing" or "stale", to the
-      default methods at the finest level); charts frame cost, stacked system cost, CG
-      iterations, refresh cost (log-log slopes), speed-up against level, speed against accuracy
-      (Pareto fronts), haptic period, memory; judges the issues' targets. Checks (exit status 1 if
-      any fails): every point runs to its end, 1 and 2 threads give the same state hash, the
-      default methods never diverge and stay within their accuracy bounds against the run's own
-      finest level. --speedup-reps N (default 5, quick 1): the capsulorhexis points on 1 and 2
-      threads run N times in all, the repeats last, so that the 2-thread speed-up is the mean of
-      N paired runs with its 95 % interval (repeats must give the same state hash), listed pair
-      by pair with where the vCPUs were: each point measures a cache line's round trip between
-      its two CPUs before and after its frames. About 25 minutes (quick about 1).
+      beside it; and each method alternative of the scene (integrators, stiffness, layout,
+      active set, spring law; broadphase, narrowphase, lens model) at levels 1, 3, 5 (quick 1).
+      Records frame and per-system p50/p99/max, CG iterations per stepped frame, physics refresh
+      per cut (and per spring it patched), the cornea's worst cut frame, the 2-thread speed-up
+      per level, haptic period and overruns, memory, and accuracy against the converged
+      reference in DIR/results/sweep_reference.json (else the source tree's perf/results; falls
+      back, labelled "missing" or "stale", to the default methods at the finest level); charts
+      frame cost, stacked system cost, CG iterations, refresh cost (log-log slopes), speed-up
+      against level, speed against accuracy (Pareto fronts), haptic period, memory; judges the
+      issues' targets. Checks (exit status 1 if any fails): every point runs to its end, 1 and 2
+      threads give the same state hash, the default methods never diverge and stay within their
+      accuracy bounds against the run's own finest level. --speedup-reps N (default 5, quick 1):
+      the capsulorhexis points on 1 and 2 threads run N times in all, the repeats last, so that
+      the 2-thread speed-up is the mean of N paired runs with its 95 % interval (repeats must
+      give the same state hash), listed pair by pair with where the vCPUs were: each point
+      measures a cache line's round trip between its two CPUs before and after its frames. About
+      25 minutes (quick about 1).
       --replot redraws the section and charts from DIR/results/sweep_points.json without
       measuring again (the figures stay those of the run that measured them).
       --reference makes DIR/results/sweep_reference.json instead: per drill, one run off the
