@@ -83,6 +83,12 @@ double physics_number(const SweepPointResult& r, const std::string& body, const 
   return r.physics[body][k].get<double>();
 }
 
+double refresh_ms_per_patched_spring(const SweepPointResult& r) {
+  const double springs = physics_number(r, "capsule_cutting", "physics_refresh_springs_mean");
+  return springs > 0 ? physics_number(r, "capsule_cutting", "physics_refresh_ms_mean") / springs
+                     : std::numeric_limits<double>::quiet_NaN();
+}
+
 double system_cost(const SweepPointResult& r, const std::string& name, double CostSummary::*field) {
   for (const auto& s : r.systems)
     if (s.name == name) return s.*field;

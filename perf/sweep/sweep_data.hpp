@@ -53,6 +53,9 @@ double point_metric(const SweepPointResult& r, const std::string& name);
 
 // A number from a point's physics summary (report.physics[body][key]); NaN when absent.
 double physics_number(const SweepPointResult& r, const std::string& body, const std::string& key);
+// The capsule's physics refresh per spring it patched (mean per cut over springs per cut), NaN
+// where the run did not count the springs (points saved before the count).
+double refresh_ms_per_patched_spring(const SweepPointResult& r);
 
 // A system's cost summary field (e.g. &CostSummary::max_ms); NaN when the system did not run.
 double system_cost(const SweepPointResult& r, const std::string& name, double CostSummary::*field);

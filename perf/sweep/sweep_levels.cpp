@@ -81,7 +81,7 @@ std::vector<LevelFigures> level_figures(const std::vector<SweepRow>& rows, const
     g.refresh_ms_mean = physics_number(r, "capsule_cutting", "physics_refresh_ms_mean");
     g.refresh_ms_max = physics_number(r, "capsule_cutting", "physics_refresh_ms_max");
     g.refresh_springs = physics_number(r, "capsule_cutting", "physics_refresh_springs_mean");
-    g.refresh_ms_per_spring = g.refresh_springs > 0 ? g.refresh_ms_mean / g.refresh_springs : kNaN;
+    g.refresh_ms_per_spring = refresh_ms_per_patched_spring(r);
     g.cut_edit_ms_max = physics_number(r, "capsule_cutting", "edit_ms_max");
     g.cornea_cut_max_ms = system_cost(r, "cornea_cut", &CostSummary::max_ms);
     g.p50_1 = a ? a->r.frame.p50_ms : kNaN, g.p99_1 = a ? a->r.frame.p99_ms : kNaN;

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <limits>
 #include <map>
 
 #include "engine/core/error.hpp"
@@ -279,13 +278,7 @@ std::string topology_targets_md(const Section& s) {
       topo.push_back(
           {"capsulorhexis: physics refresh per patched spring (the refresh's mean over the springs "
            "it added and removed)",
-           fit_of("capsulorhexis", [](const SweepPointResult& r) {
-             const double springs =
-                 physics_number(r, "capsule_cutting", "physics_refresh_springs_mean");
-             return springs > 0
-                        ? physics_number(r, "capsule_cutting", "physics_refresh_ms_mean") / springs
-                        : std::numeric_limits<double>::quiet_NaN();
-           })});
+           fit_of("capsulorhexis", refresh_ms_per_patched_spring)});
       topo.push_back({"capsulorhexis: capsule_cut system, worst frame",
                       fit_of("capsulorhexis", [](const SweepPointResult& r) {
                         return system_cost(r, "capsule_cut", &CostSummary::max_ms);
