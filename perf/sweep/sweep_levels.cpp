@@ -6,6 +6,7 @@
 #include <limits>
 #include <tuple>
 
+#include "engine/core/error.hpp"
 #include "perf/report.hpp"
 
 namespace phaco::perf {
@@ -275,15 +276,19 @@ Baseline load_baseline(const fs::path& path) {
   Baseline b;
   std::ifstream in(path);
   if (!in) return b;
-  const nlohmann::json j = nlohmann::json::parse(in);
-  b.source = j.value("source", "");
-  for (const auto& p : j.at("points")) {
-    SweepPointResult r;
-    r.config.drill = p.at("drill");
-    r.config.level = p.at("level");
-    r.metrics = p.at("metrics");
-    r.ok = true;
-    b.points.push_back(std::move(r));
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    b.source = j.value("source", "");
+    for (const auto& p : j.at("points")) {
+      SweepPointResult r;
+      r.config.drill = p.at("drill");
+      r.config.level = p.at("level");
+      r.metrics = p.at("metrics");
+      r.ok = true;
+      b.points.push_back(std::move(r));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError("sweep: the baseline " + path.string() + " is unreadable: " + e.what());
   }
   return b;
 }

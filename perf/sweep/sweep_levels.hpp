@@ -84,7 +84,8 @@ struct Baseline {
   std::string source;                    // where the metrics came from
   std::vector<SweepPointResult> points;  // config.drill, config.level, metrics
 };
-Baseline load_baseline(const std::filesystem::path& path);  // empty when missing
+// Empty when the file is missing; an InputError naming it when it is not a baseline.
+Baseline load_baseline(const std::filesystem::path& path);
 
 // The issue-17 rows of the Targets table, judged from the points; `baseline` gives the accuracy
 // target's "today's default", measured against the same reference as the rows' errors.

@@ -341,7 +341,14 @@ int sweep_point_main(const std::vector<std::string>& args) {
     std::fprintf(stderr, "phaco-perf _sweep-point: cannot read %s\n", args[0].c_str());
     return 2;
   }
-  const SweepPointConfig config = config_from_json(nlohmann::json::parse(in));
+  SweepPointConfig config;
+  try {
+    config = config_from_json(nlohmann::json::parse(in));
+  } catch (const nlohmann::json::exception& e) {
+    std::fprintf(stderr, "phaco-perf _sweep-point: %s is not a sweep point's configuration: %s\n",
+                 args[0].c_str(), e.what());
+    return 2;
+  }
   SweepPointResult r;
   try {
     r = run_sweep_point(config);

@@ -145,6 +145,46 @@ TEST(SweepPoint, AChildThatFailsOrCrashesIsReportedNotFatal) {
   fs::remove_all(dir);
 }
 
+// The child's own entry point: an input it cannot read as a point's configuration (empty, not
+// JSON, a field of the wrong type or missing) is exit status 2 and a line naming the file, not an
+// uncaught exception; no result file is written.
+TEST(SweepPoint, AnUnreadableConfigurationIsAnErrorNotACrash) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("phaco_sweep_cfg_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path out = dir / "out.json";
+  for (const std::string text : {"", "{not json", "[]", R"({"drill": 1})", R"({"drill": "x"})"}) {
+    SCOPED_TRACE(text);
+    const fs::path in = dir / "in.json";
+    std::ofstream(in) << text;
+    EXPECT_EQ(sweep_point_main({in.string(), out.string()}), 2);
+    EXPECT_FALSE(fs::exists(out));
+  }
+  EXPECT_EQ(sweep_point_main({(dir / "missing.json").string(), out.string()}), 2);
+  EXPECT_EQ(sweep_point_main({"only-one-argument"}), 2);
+  fs::remove_all(dir);
+}
+
+// The baseline the accuracy target compares with: missing is no baseline; present but unreadable
+// is an input error naming the file (the study's "internal error" before).
+TEST(SweepLevels, AnUnreadableBaselineIsNamed) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("phaco_sweep_base_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  EXPECT_TRUE(load_baseline(dir / "missing.json").points.empty());
+  for (const std::string text : {"{not json", R"({"points": [{"drill": "capsulorhexis"}]})"}) {
+    SCOPED_TRACE(text);
+    std::ofstream(dir / "baseline.json") << text;
+    try {
+      load_baseline(dir / "baseline.json");
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("baseline.json"), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // The 2-thread speed-up over repeated pairs (issue 17 item 7): the plan runs the capsulorhexis
 // default points again at its end, thread order alternating, each repeat keyed as the default
 // point (its state hash must match); a level's speed-up is the mean of its paired ratios.
